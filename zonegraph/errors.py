@@ -1,0 +1,49 @@
+"""Typed errors that name the input and the reason.
+
+Every user-facing failure derives from :class:`ZoneGraphError`, so the CLI and the pipeline can
+turn it into a one-line message or a manifest row without a traceback, while programming errors
+(any other exception) still surface loudly.
+"""
+
+from __future__ import annotations
+
+
+class ZoneGraphError(Exception):
+    """A failure caused by the input, not by a bug: carries the source and a short reason."""
+
+    status = "error"
+
+    def __init__(self, source: str, reason: str):
+        super().__init__(f"{source}: {reason}")
+        self.source = source
+        self.reason = reason
+
+
+class InputError(ZoneGraphError):
+    """The file cannot be read: missing, corrupt, empty, or of the wrong kind."""
+
+    status = "invalid_input"
+
+
+class DesignError(ZoneGraphError):
+    """A design file is readable but inconsistent (a missing entity, a loop that does not close)."""
+
+    status = "invalid_design"
+
+    def __init__(self, design: str, entity: str | None, reason: str):
+        where = f"{design} [{entity}]" if entity else design
+        super().__init__(where, reason)
+        self.design = design
+        self.entity = entity
+
+
+class UnsupportedFeatureError(DesignError):
+    """The design uses something outside the sketch + extrude subset we replay exactly."""
+
+    status = "unsupported"
+
+
+class ReplayError(DesignError):
+    """OpenCASCADE could not build a step (a Boolean failed or produced no solid)."""
+
+    status = "replay_failed"
