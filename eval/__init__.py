@@ -1,0 +1,1 @@
+"""Evaluation: relative GT rank, IoU vs time curves, coverage tables, plots and reports (planned)."""

@@ -1,0 +1,24 @@
+"""Shared fixtures: the real Fusion 360 Gallery samples from ../shared (skipped when absent)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+SAMPLES = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "fusion360_samples"
+SKIP_REASON = f"real Fusion 360 Gallery samples not found at {SAMPLES} (clone with ../shared beside the repo)"
+
+
+def sample_paths() -> list[Path]:
+    return sorted(SAMPLES.glob("*.json")) if SAMPLES.is_dir() else []
+
+
+@pytest.fixture(scope="session")
+def samples_dir() -> Path:
+    if not SAMPLES.is_dir():
+        pytest.skip(SKIP_REASON)
+    return SAMPLES
+
+
+requires_samples = pytest.mark.skipif(not SAMPLES.is_dir(), reason=SKIP_REASON)
