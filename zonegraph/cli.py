@@ -42,6 +42,24 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_build(args: argparse.Namespace) -> int:
+    from .isolation import run_isolated
+    from .jobs import build_and_save
+
+    outcome = run_isolated(build_and_save, (args.target, args.out, not args.no_simplify, args.samples, args.seed),
+                           timeout=args.timeout)
+    if not outcome.ok:
+        print(f"zonegraph: error: {args.target}: {outcome.status}: {outcome.reason}", file=sys.stderr)
+        return EXIT_USER_ERROR
+    s = outcome.value
+    print(f"{Path(args.target).name}: status {s['status']}, {s['zones']} zones ({s['inside_zones']} inside), "
+          f"{s['faces']} faces, {s['edges']} edges, {s['surfaces']} surfaces from {s['target_faces']} target faces"
+          f"{'' if s['simplified'] else ' (not simplified)'}")
+    laps = ", ".join(f"{k[:-2]} {v:.3f}" for k, v in s.items() if k.endswith("_s") and k != "build_s")
+    print(f"  built in {s['build_s']:.3f} s ({laps}) -> {args.out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="zonegraph", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -49,6 +67,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("design", help="design JSON file")
     p.add_argument("--out", required=True, help="output folder (final.step, steps/, summary.json)")
     p.set_defaults(func=_cmd_replay)
+    p = sub.add_parser("build", help="build the zone graph of a STEP/BREP part or a design JSON")
+    p.add_argument("target", help="PART.step, PART.brep or DESIGN.json")
+    p.add_argument("--out", required=True, help="output folder (Parquet tables and zones.brep)")
+    p.add_argument("--no-simplify", action="store_true", help="extend face-loop walls as full planes")
+    p.add_argument("--samples", type=int, default=512, help="surface samples per zone")
+    p.add_argument("--seed", type=int, default=0, help="seed of the surface samples")
+    p.add_argument("--timeout", type=float, default=600.0, help="seconds before the build is stopped")
+    p.set_defaults(func=_cmd_build)
     return parser
 
 

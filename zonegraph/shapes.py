@@ -34,8 +34,8 @@ def read_shape(path: str | Path) -> Shape:
         raise
     except Exception as exc:  # OCP raises bare RuntimeError/ValueError for corrupt files
         raise InputError(str(path), f"cannot read {suffix[1:].upper()} ({exc})") from None
-    if shape is None or shape.wrapped is None or shape.wrapped.IsNull():
-        raise InputError(str(path), "file holds no shape")
+    if shape is None or shape.is_null:
+        raise InputError(str(path), "file holds no shape (corrupt or empty)")
     return shape
 
 

@@ -1,0 +1,70 @@
+"""DVC stage ``zonegraphs``: every replayed design's final solid -> its zone graph.
+
+Graphs go to ``data/zonegraphs/graphs/<id>/`` (see ``zonegraph.zone_io``); the manifest
+``data/zonegraphs/manifest.parquet`` has one row per design (status, reason, target faces, zones,
+edges, build seconds, simplified), designs that failed to replay included with their status.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from zonegraph.jobs import build_and_save
+
+from .cluster import dask_client
+from .params import load_params
+from .runner import Job, fingerprint, run_jobs
+
+OUT = Path("data/zonegraphs")
+METRICS = Path("data/metrics/zonegraphs.json")
+ZONEGRAPH_VERSION = 1
+
+
+def main() -> None:
+    params = load_params()
+    cfg = params["zonegraph"]
+    replayed = pd.read_parquet("data/replay/manifest.parquet")
+    ok = replayed[replayed["status"] == "ok"]
+    settings = (ZONEGRAPH_VERSION, bool(cfg["simplify"]), int(cfg["samples"]), int(cfg["seed"]))
+    jobs = [
+        Job(row.design_id, fingerprint(*settings, files=(f"{row.brep_dir}/final.brep",)),
+            (f"{row.brep_dir}/final.brep", str(OUT / "graphs" / row.design_id), *settings[1:]))
+        for row in ok.itertuples()
+    ]
+    with dask_client(params["dask"]) as client:
+        records = run_jobs(build_and_save, jobs, OUT / "records", client, float(cfg["timeout_s"]), "zonegraphs")
+    built = pd.DataFrame(records).drop(columns=["fingerprint"])
+    skipped = replayed.loc[replayed["status"] != "ok", ["design_id", "status", "error"]].rename(columns={"error": "reason"})
+    manifest = pd.concat([built, skipped], ignore_index=True)
+    manifest = manifest.merge(replayed[["design_id", "split"]], on="design_id")
+    manifest = manifest.rename(columns={"target_faces": "faces_in", "faces": "partition_faces",
+                                        "seconds": "job_seconds"})
+    manifest["simplified"] = bool(cfg["simplify"])
+    manifest.to_parquet(OUT / "manifest.parquet", index=False)
+    write_metrics(manifest)
+
+
+def write_metrics(manifest: pd.DataFrame) -> None:
+    ok = manifest["status"] == "ok"
+    build = manifest.loc[ok, "build_s"].to_numpy(float)
+    metrics = {
+        "designs": int(len(manifest)), "ok": int(ok.sum()),
+        "by_status": {k: int(v) for k, v in manifest["status"].value_counts().items()},
+        "median_build_s": float(np.median(build)) if len(build) else None,
+        "p90_build_s": float(np.percentile(build, 90)) if len(build) else None,
+        "median_zones": float(manifest.loc[ok, "zones"].median()) if ok.any() else None,
+    }
+    METRICS.parent.mkdir(parents=True, exist_ok=True)
+    METRICS.write_text(json.dumps(metrics, indent=2))
+    print(f"zonegraphs: {metrics['ok']}/{metrics['designs']} ok, median build {metrics['median_build_s']} s, "
+          f"by status {metrics['by_status']}")
+    for row in manifest.loc[~ok].itertuples():
+        print(f"  {row.design_id}: {row.status}: {row.reason}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,88 @@
+"""Small OCP helpers shared by the zone-graph modules (points, maps, properties)."""
+
+from __future__ import annotations
+
+import numpy as np
+from OCP.Bnd import Bnd_Box
+from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepGProp import BRepGProp
+from OCP.GProp import GProp_GProps
+from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
+from OCP.TopAbs import TopAbs_ShapeEnum
+from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.BRep import BRep_Builder
+from OCP.TopoDS import TopoDS_Compound, TopoDS_Shape
+from OCP.collections import (
+    IndexedDataMap_TopoDS_Shape_List_TopoDS_Shape_TopTools_ShapeMapHasher as AncestorMap,
+    IndexedMap_TopoDS_Shape_TopTools_ShapeMapHasher as ShapeIndex,
+)
+
+
+def pnt(p) -> gp_Pnt:
+    return gp_Pnt(float(p[0]), float(p[1]), float(p[2]))
+
+
+def direction(v) -> gp_Dir:
+    return gp_Dir(float(v[0]), float(v[1]), float(v[2]))
+
+
+def vec(v) -> gp_Vec:
+    return gp_Vec(float(v[0]), float(v[1]), float(v[2]))
+
+
+def xyz(p) -> np.ndarray:
+    return np.array([p.X(), p.Y(), p.Z()])
+
+
+def sub_shapes(shape: TopoDS_Shape, kind: TopAbs_ShapeEnum) -> list[TopoDS_Shape]:
+    """Sub-shapes in exploration order (oriented as they appear in ``shape``; repeats kept)."""
+    out = []
+    ex = TopExp_Explorer(shape, kind)
+    while ex.More():
+        out.append(ex.Current())
+        ex.Next()
+    return out
+
+
+def shape_index(shape: TopoDS_Shape, kind: TopAbs_ShapeEnum) -> ShapeIndex:
+    """Distinct sub-shapes with stable 1-based indices (same order for the same topology)."""
+    index = ShapeIndex()
+    TopExp.MapShapes_s(shape, kind, index)
+    return index
+
+
+def ancestors(shape: TopoDS_Shape, kind: TopAbs_ShapeEnum, parent: TopAbs_ShapeEnum) -> AncestorMap:
+    amap = AncestorMap()
+    TopExp.MapShapesAndAncestors_s(shape, kind, parent, amap)
+    return amap
+
+
+def volume_props(shape: TopoDS_Shape) -> tuple[float, np.ndarray]:
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    return props.Mass(), xyz(props.CentreOfMass())
+
+
+def surface_props(shape: TopoDS_Shape) -> tuple[float, np.ndarray]:
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(shape, props)
+    return props.Mass(), xyz(props.CentreOfMass())
+
+
+def bounds(shape: TopoDS_Shape, optimal: bool = True) -> np.ndarray:
+    """[xmin, ymin, zmin, xmax, ymax, zmax]; ``optimal`` uses exact geometry (no enlargement)."""
+    box = Bnd_Box()
+    if optimal:
+        BRepBndLib.AddOptimal_s(shape, box, False, False)
+    else:
+        BRepBndLib.Add_s(shape, box)
+    return np.concatenate([xyz(box.CornerMin()), xyz(box.CornerMax())])
+
+
+def make_compound(shapes) -> TopoDS_Compound:
+    comp = TopoDS_Compound()
+    builder = BRep_Builder()
+    builder.MakeCompound(comp)
+    for s in shapes:
+        builder.Add(comp, s)
+    return comp
