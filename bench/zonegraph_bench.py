@@ -1,0 +1,78 @@
+"""Zone graph build time, zone count and face count on the real samples and synthetic designs,
+simplified and not.
+
+    python -m bench.zonegraph_bench [--synthetic N] [--workers 2] [--timeout 120]
+
+Each design is built in its own process under a timeout (one core each; ``--workers`` run side
+by side). Prints medians, the slowest designs and every failure with its status and reason.
+"""
+
+from __future__ import annotations
+
+import argparse
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from zonegraph.design import load_design, parse_design
+from zonegraph.isolation import Outcome, run_isolated
+from zonegraph.partition import build_zone_graph
+from zonegraph.replay import replay
+from zonegraph.synthetic import generate_design
+
+SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
+
+
+def _build(source: str, simplify: bool) -> dict:
+    if source.startswith("synthetic:"):
+        i = int(source.split(":")[1])
+        design = parse_design(generate_design(f"synth_{i:05d}", 2021 * 1_000_003 + i), f"synth_{i:05d}")
+    else:
+        design = load_design(source)
+    return build_zone_graph(list(replay(design).bodies), simplify=simplify, samples=512, source=source).summary()
+
+
+def _job(args: tuple[str, bool, float]) -> tuple[str, bool, Outcome]:
+    source, simplify, timeout = args
+    return source, simplify, run_isolated(_build, (source, simplify), timeout)
+
+
+def report(name: str, results: list[tuple[str, bool, Outcome]]) -> None:
+    for simplify in (True, False):
+        rows = [(s, o) for s, simp, o in results if simp == simplify]
+        ok = [(s, o.value) for s, o in rows if o.ok]
+        label = f"{name}, {'simplified' if simplify else 'not simplified'}"
+        if not ok:
+            print(f"\n{label}: no graph built")
+            continue
+        build = np.array([v["build_s"] for _, v in ok])
+        zones = np.array([v["zones"] for _, v in ok])
+        faces = np.array([v["target_faces"] for _, v in ok])
+        print(f"\n{label}: {len(ok)}/{len(rows)} ok")
+        print(f"  build s   median {np.median(build):.3f}  p90 {np.percentile(build, 90):.3f}  max {build.max():.2f}")
+        print(f"  zones     median {np.median(zones):.0f}  p90 {np.percentile(zones, 90):.0f}  max {zones.max()}")
+        print(f"  faces     median {np.median(faces):.0f}  max {faces.max()}")
+        slow = sorted(ok, key=lambda r: -r[1]["build_s"])[:3]
+        print("  slowest: " + ", ".join(f"{Path(s).stem} ({v['zones']} zones, {v['build_s']:.2f} s)" for s, v in slow))
+        for s, o in rows:
+            if not o.ok:
+                print(f"  FAILED {Path(s).stem}: {o.status}: {o.reason}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--synthetic", type=int, default=300)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--timeout", type=float, default=120.0)
+    args = parser.parse_args()
+    samples = [str(p) for p in sorted(SAMPLES.glob("*.json"))] if SAMPLES.is_dir() else []
+    synthetic = [f"synthetic:{i}" for i in range(args.synthetic)]
+    with ProcessPoolExecutor(args.workers) as pool:
+        for name, sources in (("real samples", samples), ("synthetic", synthetic)):
+            jobs = [(s, simp, args.timeout) for s in sources for simp in (True, False)]
+            report(name, list(pool.map(_job, jobs, chunksize=2)))
+
+
+if __name__ == "__main__":
+    main()
