@@ -60,6 +60,24 @@ def _cmd_build(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_infer(args: argparse.Namespace) -> int:
+    from .infer import InferConfig, infer
+    from .isolation import run_isolated
+
+    config = InferConfig(args.guide, args.budget, args.k, args.k_decay, args.max_depth, args.seed)
+    timeout = args.timeout or 3 * args.budget + 300  # the build and the export are not budgeted
+    outcome = run_isolated(infer, (args.target, args.out, config), timeout=timeout)
+    if not outcome.ok:
+        print(f"zonegraph: error: {args.target}: {outcome.status}: {outcome.reason}", file=sys.stderr)
+        return EXIT_USER_ERROR
+    r = outcome.value
+    print(f"{Path(args.target).name}: {r['status']}, {r['steps']} steps ({', '.join(r['operations'])}), "
+          f"B-rep IoU {r['iou_brep']:.6f}, zone IoU {r['iou_zone']:.6f}")
+    print(f"  {r['zones']} zones, build {r['build_s']:.2f} s, search {r['search_s']:.2f} s "
+          f"(best after {r['time_to_best_s']:.2f} s, {r['expansions']} expansions) -> {args.out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="zonegraph", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -75,6 +93,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="seed of the surface samples")
     p.add_argument("--timeout", type=float, default=600.0, help="seconds before the build is stopped")
     p.set_defaults(func=_cmd_build)
+    p = sub.add_parser("infer", help="infer an editable sketch + extrude program that rebuilds a part")
+    p.add_argument("target", help="PART.step, PART.brep or DESIGN.json (its final shape)")
+    p.add_argument("--out", required=True, help="output folder (result.json, sequence.py/.json/.png, steps/)")
+    p.add_argument("--guide", choices=["heuristic", "random"], default="heuristic", help="proposal ranking")
+    p.add_argument("--budget", type=float, default=10.0, help="search seconds (zone graph build excluded)")
+    p.add_argument("--k", type=int, default=5, help="proposals kept per state (top-k)")
+    p.add_argument("--k-decay", type=float, default=0.0, help="k decrease per depth level")
+    p.add_argument("--max-depth", type=int, default=20, help="longest program searched")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random guide")
+    p.add_argument("--timeout", type=float, default=None, help="hard stop in seconds (default 3 x budget + 300)")
+    p.set_defaults(func=_cmd_infer)
     return parser
 
 

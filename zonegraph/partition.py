@@ -342,6 +342,8 @@ class _ZoneMesh:
         normals = np.array([surfaces[i].normal for i in plane_ids])
         offsets = np.array([surfaces[i].offset for i in plane_ids])
         for z, (c, _, _) in enumerate(self.zone_tris):
+            if not len(c):
+                continue  # an unmeshable zone: it has no interior point either, and fails the checks
             d = c.reshape(-1, 3) @ normals.T - offsets
             lo, hi = d.min(axis=0), d.max(axis=0)
             sides[plane_ids, z] = np.where(lo > -SIDE_TOL, 1, np.where(hi < SIDE_TOL, -1, 0))

@@ -66,9 +66,10 @@ def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGe
     return out
 
 
-def rebuild(program: list[ProgramStep]) -> Shape | None:
-    """Execute the program: the first union starts the part, then unions and subtractions."""
+def execute(program: list[ProgramStep]) -> list[Shape | None]:
+    """The shape after each step: the first union starts the part, then unions and subtractions."""
     shape: Shape | None = None
+    states = []
     for step in program:
         tool = step.tool()
         if shape is None:
@@ -77,7 +78,8 @@ def rebuild(program: list[ProgramStep]) -> Shape | None:
             shape = shape.fuse(tool).clean()
         else:
             shape = shape.cut(tool).clean()
-    return shape
+        states.append(shape)
+    return states
 
 
 def brep_iou(a: Shape | None, b: Shape) -> float:
