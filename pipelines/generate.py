@@ -16,14 +16,14 @@ import pandas as pd
 from zonegraph.dataset import read_dataset
 from zonegraph.design import load_design
 from zonegraph.design_stats import design_statistics, format_comparison
+from zonegraph import synthetic
 from zonegraph.synthetic import generate_design
 
 from .cluster import dask_client
 from .params import load_params
-from .runner import Job, fingerprint, run_jobs
+from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/designs")
-GENERATOR_VERSION = 1
 
 
 def design_seed(base: int, index: int) -> int:
@@ -40,11 +40,12 @@ def write_design(design_id: str, seed: int, path: str) -> dict:
 def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
     json_dir = OUT / "json"
     json_dir.mkdir(parents=True, exist_ok=True)
+    code = code_fingerprint(synthetic)
     jobs = []
     for i in range(count):
         design_id = f"synth_{i:05d}"
         s = design_seed(seed, i)
-        jobs.append(Job(design_id, fingerprint(GENERATOR_VERSION, s), (design_id, s, str(json_dir / f"{design_id}.json"))))
+        jobs.append(Job(design_id, fingerprint(code, s), (design_id, s, str(json_dir / f"{design_id}.json"))))
     with dask_client(dask_cfg) as client:
         records = run_jobs(write_design, jobs, OUT / "records", client, timeout, "generate")
     failed = [r for r in records if r["status"] != "ok"]

@@ -12,17 +12,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from zonegraph import design, profiles
+from zonegraph import replay as replay_module
 from zonegraph.design import load_design
 from zonegraph.replay import replay
 from zonegraph.shapes import write_brep
 
 from .cluster import dask_client
 from .params import load_params
-from .runner import Job, fingerprint, run_jobs
+from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/replay")
 METRICS = Path("data/metrics/replay.json")
-REPLAY_VERSION = 1
 
 
 def replay_design(path: str, out_dir: str) -> dict:
@@ -48,8 +49,9 @@ def replay_design(path: str, out_dir: str) -> dict:
 def main() -> None:
     params = load_params()
     index = pd.read_parquet("data/designs/index.parquet")
+    code = code_fingerprint(design, profiles, replay_module)
     jobs = [
-        Job(row.design_id, fingerprint(REPLAY_VERSION, files=(row.path,)),
+        Job(row.design_id, fingerprint(code, files=(row.path,)),
             (row.path, str(OUT / "breps" / row.design_id)))
         for row in index.itertuples()
     ]

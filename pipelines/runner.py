@@ -13,6 +13,7 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
 from typing import Any, Callable
 
 from distributed import Client, as_completed
@@ -33,6 +34,11 @@ def fingerprint(*parts: Any, files: tuple[str | Path, ...] = ()) -> str:
     for f in files:
         h.update(Path(f).read_bytes())
     return h.hexdigest()
+
+
+def code_fingerprint(*modules: ModuleType) -> str:
+    """A hash of the modules' source: records made by other code are recomputed, not reused."""
+    return fingerprint(files=tuple(m.__file__ for m in modules))
 
 
 def _execute(fn: Callable, job: Job, timeout: float | None) -> dict:

@@ -13,15 +13,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from zonegraph import extension, face_loops, partition, zone_graph, zone_io
 from zonegraph.jobs import build_and_save
 
 from .cluster import dask_client
 from .params import load_params
-from .runner import Job, fingerprint, run_jobs
+from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/zonegraphs")
 METRICS = Path("data/metrics/zonegraphs.json")
-ZONEGRAPH_VERSION = 1
 
 
 def main() -> None:
@@ -29,7 +29,8 @@ def main() -> None:
     cfg = params["zonegraph"]
     replayed = pd.read_parquet("data/replay/manifest.parquet")
     ok = replayed[replayed["status"] == "ok"]
-    settings = (ZONEGRAPH_VERSION, bool(cfg["simplify"]), int(cfg["samples"]), int(cfg["seed"]))
+    code = code_fingerprint(extension, face_loops, partition, zone_graph, zone_io)
+    settings = (code, bool(cfg["simplify"]), int(cfg["samples"]), int(cfg["seed"]))
     jobs = [
         Job(row.design_id, fingerprint(*settings, files=(f"{row.brep_dir}/final.brep",)),
             (f"{row.brep_dir}/final.brep", str(OUT / "graphs" / row.design_id), *settings[1:]))

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from build123d import Edge, Face, GeomType, Shape
+from build123d import Edge, Face, GeomType, Shape, Unit
 
 from .design import (
     Arc, Circle, Curve, Design, Extent, ExtentType, Extrude, Frame, Line, Loop, Nurbs, Operation,
@@ -57,9 +57,14 @@ def local_edges(edge: Edge, frame: Frame) -> LocalEdge:
     return LocalEdge("spline", np.array([_local(frame, edge.position_at(t)) for t in np.linspace(0, 1, 24)]))
 
 
+def face_wires(face: Face) -> list[tuple[bool, list[Edge]]]:
+    """(is_outer, edges) per boundary loop; merged faces can carry empty wires, which are dropped."""
+    wires = [(True, face.outer_wire())] + [(False, w) for w in face.inner_wires()]
+    return [(outer, list(w.edges())) for outer, w in wires if w.edges()]
+
+
 def face_loops(face: Face, frame: Frame) -> list[tuple[bool, list[LocalEdge]]]:
-    loops = [(True, face.outer_wire())] + [(False, w) for w in face.inner_wires()]
-    return [(outer, [local_edges(e, frame) for e in wire.edges()]) for outer, wire in loops]
+    return [(outer, [local_edges(e, frame) for e in edges]) for outer, edges in face_wires(face)]
 
 
 # --------------------------------------------------------------------------- build123d script
@@ -83,11 +88,11 @@ def _edge_code(e: LocalEdge) -> str:
     return "Spline(" + ", ".join(_xy(p) for p in e.points) + ")  # interpolates the original curve"
 
 
-def program_script(program: list[ProgramStep], name: str, units: str) -> str:
+def program_script(program: list[ProgramStep], name: str, unit: Unit) -> str:
     lines = [
         f'"""{name}: {len(program)} sketch + extrude steps found by `zonegraph infer`.',
         "",
-        f"Units and position are the input's ({units}). Run `python sequence.py [out.step]`.",
+        f"Units ({unit.name.lower()}) and position are the input's. Run `python sequence.py [out.step]`.",
         '"""',
         "",
         "import sys",
@@ -112,7 +117,7 @@ def program_script(program: list[ProgramStep], name: str, units: str) -> str:
         lines.append(f"    extrude(amount={step.distance:.12g}, mode={mode})")
         lines.append("")
     lines += ["result = part.part", "", 'if __name__ == "__main__" and len(sys.argv) > 1:',
-              "    export_step(result, sys.argv[1])", ""]
+              f"    export_step(result, sys.argv[1], unit=Unit.{unit.name})", ""]
     return "\n".join(lines)
 
 
@@ -148,9 +153,8 @@ def program_design(program: list[ProgramStep], name: str) -> Design:
         frame = step_frame(step)
         profiles = {}
         for j, face in enumerate(step.faces):
-            wires = [(True, face.outer_wire())] + [(False, w) for w in face.inner_wires()]
-            loops = tuple(Loop(outer, tuple(_curve(local_edges(e, frame), e, frame) for e in w.edges()))
-                          for outer, w in wires)
+            loops = tuple(Loop(outer, tuple(_curve(local_edges(e, frame), e, frame) for e in edges))
+                          for outer, edges in face_wires(face))
             profiles[f"profile{i}_{j}"] = Profile(f"profile{i}_{j}", loops, face.area)
         sketch = Sketch(f"sketch{i}", f"Sketch{i + 1}", frame, profiles)
         op = (Operation.NEW_BODY if i == 0 else Operation.JOIN) if step.op is Op.UNION else Operation.CUT
@@ -163,12 +167,19 @@ def program_design(program: list[ProgramStep], name: str) -> Design:
 # ------------------------------------------------------------------------------ STEP and PNG
 
 
-def write_outputs(program: list[ProgramStep], states: list[Shape], out: Path, name: str, units: str) -> None:
-    """sequence.py, sequence.json, steps/NN.step and sequence.png."""
+def write_outputs(program: list[ProgramStep], states: list[Shape], out: Path, name: str, unit: Unit,
+                  render: bool = True) -> None:
+    """sequence.py, sequence.json and, when ``render``, steps/NN.step and sequence.png.
+
+    ``unit`` is what the input's numbers mean (mm for STEP as read, cm for a design JSON); the
+    STEP files declare it, so they open at the input's size.
+    """
     out.mkdir(parents=True, exist_ok=True)
-    (out / "sequence.py").write_text(program_script(program, name, units))
+    (out / "sequence.py").write_text(program_script(program, name, unit))
     (out / "sequence.json").write_text(json.dumps(design_to_json(program_design(program, name)), indent=1))
+    if not render:
+        return
     for i, state in enumerate(states):
         if state is not None:
-            write_step(state, out / "steps" / f"{i:02d}.step")
+            write_step(state, out / "steps" / f"{i:02d}.step", unit)
     render_sequence(program, states, out / "sequence.png")

@@ -13,6 +13,8 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from build123d import Unit
+
 from .export import write_outputs
 from .partition import build_zone_graph
 from .program import brep_iou, build_program, execute
@@ -44,9 +46,9 @@ def make_ranker(guide: str, seed: int = 0) -> Ranker:
     raise ValueError(f"unknown guide {guide!r} (heuristic or random)")
 
 
-def _units(path: Path) -> str:
-    return {".json": "centimetres, the design's units", ".step": "millimetres, as STEP is read",
-            ".stp": "millimetres, as STEP is read"}.get(path.suffix.lower(), "the file's units")
+def input_unit(path: Path) -> Unit:
+    """What the target's numbers mean: design JSON is in cm; STEP is read in mm (BREP has no unit)."""
+    return Unit.CM if path.suffix.lower() == ".json" else Unit.MM
 
 
 def reconstruct(target_path: str | Path, config: InferConfig = InferConfig()):
@@ -76,8 +78,10 @@ def reconstruct(target_path: str | Path, config: InferConfig = InferConfig()):
     return (*best, build_s, search_s, solids)
 
 
-def infer(target_path: str, out: str, config: InferConfig = InferConfig()) -> dict:
-    """Reconstruct, rebuild, verify and export; returns the contents of result.json."""
+def infer(target_path: str, out: str, config: InferConfig = InferConfig(), render: bool = True) -> dict:
+    """Reconstruct, rebuild, verify and export; returns the contents of result.json.
+
+    ``render=False`` skips the per-step STEP files and the PNG (the pipeline's bulk runs)."""
     path, out_dir = Path(target_path), Path(out)
     graph, gen, result, build_s, search_s, solids = reconstruct(path, config)
     program = build_program(graph, result.steps, gen)
@@ -85,7 +89,7 @@ def infer(target_path: str, out: str, config: InferConfig = InferConfig()) -> di
     final = states[-1] if states else None
     iou = brep_iou(final, as_shape(solids))
     if program:
-        write_outputs(program, states, out_dir, path.stem, _units(path))
+        write_outputs(program, states, out_dir, path.stem, input_unit(path), render)
     summary = {
         "status": "exact" if result.exact and iou >= EXACT_IOU else "partial",
         "exact": bool(result.exact and iou >= EXACT_IOU), "iou_zone": result.iou, "iou_brep": iou,

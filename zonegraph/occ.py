@@ -10,8 +10,9 @@ from OCP.GProp import GProp_GProps
 from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
 from OCP.TopAbs import TopAbs_ShapeEnum
 from OCP.TopExp import TopExp, TopExp_Explorer
-from OCP.BRep import BRep_Builder
-from OCP.TopoDS import TopoDS_Compound, TopoDS_Shape
+from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Shape
 from OCP.collections import (
     IndexedDataMap_TopoDS_Shape_List_TopoDS_Shape_TopTools_ShapeMapHasher as AncestorMap,
     IndexedMap_TopoDS_Shape_TopTools_ShapeMapHasher as ShapeIndex,
@@ -86,3 +87,15 @@ def make_compound(shapes) -> TopoDS_Compound:
     for s in shapes:
         builder.Add(comp, s)
     return comp
+
+
+def face_triangles(face) -> tuple[np.ndarray, np.ndarray]:
+    """Mesh nodes (N, 3) and triangles (T, 3) of a meshed face; empty if it has no mesh."""
+    loc = TopLoc_Location()
+    tri = BRep_Tool.Triangulation_s(TopoDS.Face(face), loc)
+    if tri is None:
+        return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
+    trsf = loc.Transformation()
+    nodes = np.array([xyz(tri.Node(i).Transformed(trsf)) for i in range(1, tri.NbNodes() + 1)])
+    tris = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], np.int64) - 1
+    return nodes, tris.reshape(-1, 3)

@@ -15,19 +15,17 @@ from typing import Sequence
 
 import numpy as np
 from OCP.BOPAlgo import BOPAlgo_Builder
-from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepClass3d import BRepClass3d_SolidClassifier
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
 from OCP.GeomAbs import GeomAbs_Cylinder, GeomAbs_Plane
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN, TopAbs_INTERNAL, TopAbs_REVERSED, TopAbs_SOLID
-from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 
 from .extension import ExtendedSurface, SurfaceKind, canonical, extend_faces, parallel
 from .normalize import Normalization
-from .occ import ancestors, bounds, make_compound, pnt, shape_index, sub_shapes, surface_props, volume_props, xyz
+from .occ import ancestors, bounds, face_triangles, make_compound, pnt, shape_index, sub_shapes, surface_props, volume_props, xyz
 from .zone_graph import BuildStatus, ZoneGraph, ZoneGraphBuildError
 
 # Fuzzy values of the general fuse, in normalised units, tried in turn: 1e-7..1e-5 leave zone counts
@@ -265,7 +263,7 @@ class _ZoneMesh:
     def __init__(self, topo: _Topology):
         self.topo = topo
         BRepMesh_IncrementalMesh(topo.compound, MESH_DEFLECTION, False, 0.5, False)
-        self.face_mesh = [_triangles(f) for f in topo.faces]
+        self.face_mesh = [face_triangles(f) for f in topo.faces]
         self.zone_tris = [self._zone_triangles(z) for z in topo.zones]
 
     def _zone_triangles(self, zone) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -348,17 +346,6 @@ class _ZoneMesh:
             lo, hi = d.min(axis=0), d.max(axis=0)
             sides[plane_ids, z] = np.where(lo > -SIDE_TOL, 1, np.where(hi < SIDE_TOL, -1, 0))
         return sides
-
-
-def _triangles(face) -> tuple[np.ndarray, np.ndarray]:
-    loc = TopLoc_Location()
-    tri = BRep_Tool.Triangulation_s(face, loc)
-    if tri is None:
-        return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
-    trsf = loc.Transformation()
-    nodes = np.array([xyz(tri.Node(i).Transformed(trsf)) for i in range(1, tri.NbNodes() + 1)])
-    tris = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)], np.int64) - 1
-    return nodes, tris.reshape(-1, 3)
 
 
 def _classify(points: np.ndarray, solids: Sequence[TopoDS_Shape]) -> np.ndarray:

@@ -12,6 +12,10 @@ import numpy as np  # noqa: E402
 from build123d import Shape  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
+from OCP.BRepMesh import BRepMesh_IncrementalMesh  # noqa: E402
+from OCP.TopAbs import TopAbs_FACE  # noqa: E402
+
+from .occ import face_triangles, sub_shapes  # noqa: E402
 from .program import ProgramStep  # noqa: E402
 from .proposals import Op  # noqa: E402
 
@@ -20,9 +24,11 @@ COLOURS = {"shape": (0.6, 0.6, 0.6), Op.UNION: (0.2, 0.7, 0.3), Op.SUBTRACT: (0.
 
 
 def _triangles(shape: Shape, tolerance: float) -> np.ndarray:
-    verts, tris = shape.tessellate(tolerance)
-    pts = np.array([tuple(v) for v in verts])
-    return pts[np.array(tris)] if len(tris) else np.zeros((0, 3, 3))
+    """Triangle corners (T, 3, 3); faces that fail to mesh are left out rather than failing."""
+    BRepMesh_IncrementalMesh(shape.wrapped, tolerance, False, 0.5, False)
+    corners = [nodes[tris] for nodes, tris in (face_triangles(f) for f in sub_shapes(shape.wrapped, TopAbs_FACE))
+               if len(tris)]
+    return np.concatenate(corners) if corners else np.zeros((0, 3, 3))
 
 
 def _draw(ax, tris: np.ndarray, colour, alpha: float) -> None:

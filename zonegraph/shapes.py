@@ -49,10 +49,11 @@ def read_solids(path: str | Path) -> list[Solid]:
     return solids
 
 
-def write_step(shape: Shape, path: str | Path) -> Path:
+def write_step(shape: Shape, path: str | Path, unit: Unit = Unit.CM) -> Path:
+    """A STEP file declaring ``unit`` (the unit the shape's numbers are in; designs use cm)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not export_step(shape, str(path), unit=Unit.CM):
+    if not export_step(shape, str(path), unit=unit):
         raise OSError(f"{path}: STEP export failed")
     return path
 
