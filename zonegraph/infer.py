@@ -17,12 +17,13 @@ from build123d import Unit
 
 from .export import write_outputs
 from .partition import build_zone_graph
-from .program import brep_iou, build_program, execute
+from .program import RebuildError, brep_iou, build_program, execute
 from .proposals import ProposalGenerator
 from .replay import as_shape
 from .search import HeuristicRanker, RandomRanker, Ranker, SearchConfig, search
 from .targets import load_target
-from .zone_graph import ZoneGraphBuildError
+from .zone_graph import ZoneGraph, ZoneGraphBuildError
+from .zone_io import load_zone_graph
 
 EXACT_IOU = 0.9999
 FIRST_SHARE = 0.5  # of the budget, for the simplified graph
@@ -51,19 +52,29 @@ def input_unit(path: Path) -> Unit:
     return Unit.CM if path.suffix.lower() == ".json" else Unit.MM
 
 
-def reconstruct(target_path: str | Path, config: InferConfig = InferConfig()):
-    """Search the zone graphs of a target; returns (graph, generator, result, build_s, search_s)."""
+def _graph(solids, simplify: bool, source: str, saved: Path | None) -> tuple[ZoneGraph, float]:
+    """The zone graph and its build seconds; a graph saved by the pipeline is reused."""
+    if saved is not None and (saved / "zones.parquet").is_file():
+        graph = load_zone_graph(saved)
+        if graph.info.get("simplified") == simplify and graph.solids is not None:
+            return graph, float(graph.info["build_s"])
+    t0 = time.perf_counter()
+    graph = build_zone_graph(solids, simplify=simplify, samples=0, source=source)
+    return graph, time.perf_counter() - t0
+
+
+def reconstruct(target_path: str | Path, config: InferConfig = InferConfig(), saved_graph: str | None = None):
+    """Search the zone graphs of a target; returns (graph, generator, result, build_s, search_s, solids)."""
     solids = load_target(target_path)
     ranker = make_ranker(config.guide, config.seed)
     best, build_s, search_s, error = None, 0.0, 0.0, None
     for simplify in (True, False):
-        t0 = time.perf_counter()
         try:
-            graph = build_zone_graph(solids, simplify=simplify, samples=0, source=str(target_path))
+            graph, seconds = _graph(solids, simplify, str(target_path), Path(saved_graph) if saved_graph else None)
         except ZoneGraphBuildError as exc:
             error = exc
             continue
-        build_s += time.perf_counter() - t0
+        build_s += seconds
         left = config.budget_s - search_s
         budget = left * FIRST_SHARE if simplify else left
         gen = ProposalGenerator(graph)
@@ -78,20 +89,26 @@ def reconstruct(target_path: str | Path, config: InferConfig = InferConfig()):
     return (*best, build_s, search_s, solids)
 
 
-def infer(target_path: str, out: str, config: InferConfig = InferConfig(), render: bool = True) -> dict:
+def infer(target_path: str, out: str, config: InferConfig = InferConfig(), render: bool = True,
+          saved_graph: str | None = None) -> dict:
     """Reconstruct, rebuild, verify and export; returns the contents of result.json.
 
-    ``render=False`` skips the per-step STEP files and the PNG (the pipeline's bulk runs)."""
+    ``render=False`` skips the per-step STEP files and the PNG (the pipeline's bulk runs);
+    ``saved_graph`` is a folder holding this target's zone graph, reused instead of rebuilt."""
     path, out_dir = Path(target_path), Path(out)
-    graph, gen, result, build_s, search_s, solids = reconstruct(path, config)
+    graph, gen, result, build_s, search_s, solids = reconstruct(path, config, saved_graph)
     program = build_program(graph, result.steps, gen)
-    states = execute(program)
+    try:
+        states, rebuild_error = execute(program), ""
+    except RebuildError as exc:
+        states, rebuild_error = [], str(exc)
     final = states[-1] if states else None
     iou = brep_iou(final, as_shape(solids))
-    if program:
+    if states:
         write_outputs(program, states, out_dir, path.stem, input_unit(path), render)
+    status = "rebuild_failed" if rebuild_error else "exact" if result.exact and iou >= EXACT_IOU else "partial"
     summary = {
-        "status": "exact" if result.exact and iou >= EXACT_IOU else "partial",
+        "status": status, "rebuild_error": rebuild_error,
         "exact": bool(result.exact and iou >= EXACT_IOU), "iou_zone": result.iou, "iou_brep": iou,
         "steps": len(program), "time_to_best_s": result.time_to_best_s, "build_s": build_s, "search_s": search_s,
         "zones": graph.n_zones, "simplified": graph.info["simplified"], "expansions": result.expansions,

@@ -66,18 +66,26 @@ def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGe
     return out
 
 
+class RebuildError(RuntimeError):
+    """An OpenCASCADE Boolean failed on the program's own tools (a robustness failure, not a
+    wrong program): the shapes share coincident curved faces it cannot resolve."""
+
+
 def execute(program: list[ProgramStep]) -> list[Shape | None]:
     """The shape after each step: the first union starts the part, then unions and subtractions."""
     shape: Shape | None = None
     states = []
-    for step in program:
+    for i, step in enumerate(program):
         tool = step.tool()
-        if shape is None:
-            shape = tool if step.op is Op.UNION else None
-        elif step.op is Op.UNION:
-            shape = shape.fuse(tool).clean()
-        else:
-            shape = shape.cut(tool).clean()
+        try:
+            if shape is None:
+                shape = tool if step.op is Op.UNION else None
+            elif step.op is Op.UNION:
+                shape = shape.fuse(tool).clean()
+            else:
+                shape = shape.cut(tool).clean()
+        except ValueError as exc:  # build123d's word for a null Boolean result
+            raise RebuildError(f"step {i + 1}: Boolean failed ({exc})") from None
         states.append(shape)
     return states
 

@@ -63,11 +63,11 @@ class ReplayResult:
     @property
     def shape(self) -> Shape:
         """The final design: one solid, or a compound when Fusion would keep several bodies."""
-        return as_shape(self.bodies)
+        return self.steps[-1].shape
 
     @property
     def volume(self) -> float:
-        return sum(b.volume for b in self.bodies)
+        return self.steps[-1].volume
 
     @property
     def area(self) -> float:
@@ -75,7 +75,7 @@ class ReplayResult:
 
     @property
     def face_count(self) -> int:
-        return sum(len(b.faces()) for b in self.bodies)
+        return self.steps[-1].face_count
 
     @property
     def seconds(self) -> float:

@@ -81,6 +81,7 @@ class SearchResult:
     time_to_best_s: float
     trace: list[tuple[float, float]]  # (seconds, best IoU so far)
     proposals_per_state: list[int]
+    expansion_s: list[float]  # seconds per expansion (proposals + scoring)
 
 
 @dataclass
@@ -102,15 +103,18 @@ def search(graph: ZoneGraph, ranker: Ranker, config: SearchConfig = SearchConfig
     time_to_best = 0.0
     seen = {np.packbits(empty).tobytes()}
     counts: list[int] = []
+    times: list[float] = []
 
     def expand(canvas: np.ndarray, path: list[Proposal]) -> Iterator[Proposal]:
+        start = time.perf_counter()
         used = {p.inverse_key for p in path}
         props = [p for p in gen.proposals(canvas) if p.key not in used]
         counts.append(len(props))
-        if not props:
-            return iter(())
-        scores = np.asarray(ranker.score(graph, canvas, props), float)
-        order = np.argsort(-scores, kind="stable")[: config.k_at(len(path))]
+        order = []
+        if props:
+            scores = np.asarray(ranker.score(graph, canvas, props), float)
+            order = np.argsort(-scores, kind="stable")[: config.k_at(len(path))]
+        times.append(time.perf_counter() - start)
         return iter([props[i] for i in order])
 
     stack = [_Frame(empty, [], expand(empty, []))]
@@ -143,5 +147,5 @@ def search(graph: ZoneGraph, ranker: Ranker, config: SearchConfig = SearchConfig
     return SearchResult(
         exact=exact, iou=best[0], steps=best[3], canvas=best[2], expansions=len(counts),
         seconds=time.perf_counter() - t0, time_to_best_s=time_to_best, trace=trace,
-        proposals_per_state=counts,
+        proposals_per_state=counts, expansion_s=times,
     )
