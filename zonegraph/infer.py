@@ -98,12 +98,12 @@ def infer(target_path: str, out: str, config: InferConfig = InferConfig(), rende
     path, out_dir = Path(target_path), Path(out)
     graph, gen, result, build_s, search_s, solids = reconstruct(path, config, saved_graph)
     program = build_program(graph, result.steps, gen)
+    states, rebuild_error, iou = [], "", 0.0
     try:
-        states, rebuild_error = execute(program), ""
+        states = execute(program)
+        iou = brep_iou(states[-1] if states else None, as_shape(solids))
     except RebuildError as exc:
-        states, rebuild_error = [], str(exc)
-    final = states[-1] if states else None
-    iou = brep_iou(final, as_shape(solids))
+        rebuild_error = str(exc)
     if states:
         write_outputs(program, states, out_dir, path.stem, input_unit(path), render)
     status = "rebuild_failed" if rebuild_error else "exact" if result.exact and iou >= EXACT_IOU else "partial"

@@ -16,6 +16,7 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 
 from .occ import ancestors, make_compound
 from .proposals import Op, Proposal, ProposalGenerator
+from .shapes import volume_of
 from .zone_graph import ZoneGraph
 
 
@@ -91,10 +92,16 @@ def execute(program: list[ProgramStep]) -> list[Shape | None]:
 
 
 def brep_iou(a: Shape | None, b: Shape) -> float:
-    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans."""
+    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans (the common part, else a - b)."""
     if a is None:
         return 0.0
-    common = a.intersect(b)
-    inter = 0.0 if common is None else (common.volume if isinstance(common, Shape) else sum(s.volume for s in common))
+    try:
+        inter = volume_of(a.intersect(b))
+    except ValueError:  # a null Boolean result: measure the same thing through the difference
+        try:
+            inter = a.volume - volume_of(a.cut(b))
+        except ValueError:
+            raise RebuildError("Booleans against the target failed; IoU unknown") from None
     union = a.volume + b.volume - inter
     return inter / union if union > 0 else 1.0
+

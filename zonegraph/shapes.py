@@ -68,10 +68,11 @@ def write_brep(shape: Shape, path: str | Path) -> Path:
 
 def symmetric_difference_volume(a: Shape, b: Shape) -> float:
     """vol(a - b) + vol(b - a), the B-rep distance used for every exactness check."""
-    return _volume(a.cut(b)) + _volume(b.cut(a))
+    return volume_of(a.cut(b)) + volume_of(b.cut(a))
 
 
-def _volume(shape) -> float:
+def volume_of(shape) -> float:
+    """Volume of a Boolean result: a shape, a list of shapes (build123d's intersect) or None."""
     if shape is None:
         return 0.0
     if isinstance(shape, Shape):
