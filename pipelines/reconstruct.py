@@ -58,7 +58,7 @@ def main() -> None:
     jobs = []
     for guide in cfg["guides"]:
         config = InferConfig(guide, float(cfg["budget_s"]), int(cfg["k"]), float(cfg["k_decay"]),
-                             int(cfg["max_depth"]), int(cfg["seed"]))
+                             int(cfg["max_depth"]), int(cfg["seed"]), int(cfg["level"]))
         for row in test.itertuples():
             brep = f"{row.brep_dir}/final.brep"
             graph = Path("data/zonegraphs/graphs") / row.design_id

@@ -64,7 +64,7 @@ def _cmd_infer(args: argparse.Namespace) -> int:
     from .infer import InferConfig, infer
     from .isolation import run_isolated
 
-    config = InferConfig(args.guide, args.budget, args.k, args.k_decay, args.max_depth, args.seed)
+    config = InferConfig(args.guide, args.budget, args.k, args.k_decay, args.max_depth, args.seed, args.level)
     timeout = args.timeout or 3 * args.budget + 300  # the build and the export are not budgeted
     outcome = run_isolated(infer, (args.target, args.out, config), timeout=timeout)
     if not outcome.ok:
@@ -102,6 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--k-decay", type=float, default=0.0, help="k decrease per depth level")
     p.add_argument("--max-depth", type=int, default=20, help="longest program searched")
     p.add_argument("--seed", type=int, default=0, help="seed of the random guide")
+    p.add_argument("--level", type=int, default=1, help="proposal level (subsets of sketch components)")
     p.add_argument("--timeout", type=float, default=None, help="hard stop in seconds (default 3 x budget + 300)")
     p.set_defaults(func=_cmd_infer)
     return parser

@@ -37,6 +37,7 @@ class InferConfig:
     k_decay: float = 0.0
     max_depth: int = 20
     seed: int = 0
+    level: int = 1  # proposal level: sketches of 1..level and N-level..N components
 
 
 def make_ranker(guide: str, seed: int = 0) -> Ranker:
@@ -77,7 +78,7 @@ def reconstruct(target_path: str | Path, config: InferConfig = InferConfig(), sa
         build_s += seconds
         left = config.budget_s - search_s
         budget = left * FIRST_SHARE if simplify else left
-        gen = ProposalGenerator(graph)
+        gen = ProposalGenerator(graph, level=config.level)
         result = search(graph, ranker, SearchConfig(config.k, config.k_decay, config.max_depth, budget), gen)
         search_s += result.seconds
         if best is None or (result.iou, -len(result.steps)) > (best[2].iou, -len(best[2].steps)):
