@@ -18,14 +18,17 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
+# The stages run `python -m pipelines...`: the venv must come first on PATH.
 run: $(STAMP)
-	$(BIN)/dvc repro
+	PATH="$(abspath $(BIN)):$$PATH" $(BIN)/dvc repro
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)
 	$(BIN)/python -m bench.replay_bench
+	$(BIN)/python -m bench.zonegraph_bench
+	$(BIN)/python -m bench.search_bench
 
 clean:
 	rm -rf $(VENV) data mlruns
