@@ -54,6 +54,7 @@ def main() -> None:
     cfg = params["reconstruct"]
     replayed = pd.read_parquet("data/replay/manifest.parquet")
     test = replayed[(replayed["split"] == "test") & (replayed["status"] == "ok")]
+    zones = pd.read_parquet("data/zonegraphs/manifest.parquet").set_index("design_id")["zones"].fillna(0)
     code = code_fingerprint(partition, proposals, search, program, export, infer_module)
     jobs = []
     for guide in cfg["guides"]:
@@ -63,7 +64,8 @@ def main() -> None:
             brep = f"{row.brep_dir}/final.brep"
             graph = Path("data/zonegraphs/graphs") / row.design_id
             jobs.append(Job(f"{guide}__{row.design_id}", fingerprint(code, repr(config), files=(brep,)),
-                            (brep, str(OUT / guide / row.design_id), config, str(graph))))
+                            (brep, str(OUT / guide / row.design_id), config, str(graph)),
+                            cost=float(zones.get(row.design_id, 0))))
     with dask_client(params["dask"]) as client:
         records = run_jobs(reconstruct_design, jobs, OUT / "records", client,
                            float(cfg["timeout_s"]), "reconstruct")

@@ -27,6 +27,7 @@ class Job:
     key: str  # design id: names the record
     fingerprint: str  # changes whenever the job's result could change
     args: tuple
+    cost: float = 0.0  # expected run time, any scale: the costliest jobs start first
 
 
 def fingerprint(*parts: Any, files: tuple[str | Path, ...] = ()) -> str:
@@ -75,6 +76,7 @@ def run_jobs(fn: Callable, jobs: list[Job], records_dir: Path, client: Client,
             done[job.key] = rec
         else:
             todo.append(job)
+    todo.sort(key=lambda job: -job.cost)  # longest first: no big design is left to run alone at the end
     if done:
         print(f"{desc}: {len(done)} of {len(jobs)} designs already done, resuming", flush=True)
     futures = client.map(_execute, [fn] * len(todo), todo, [timeout] * len(todo), pure=False)

@@ -33,7 +33,7 @@ def main() -> None:
     settings = (code, bool(cfg["simplify"]), int(cfg["samples"]), int(cfg["seed"]))
     jobs = [
         Job(row.design_id, fingerprint(*settings, files=(f"{row.brep_dir}/final.brep",)),
-            (f"{row.brep_dir}/final.brep", str(OUT / "graphs" / row.design_id), *settings[1:]))
+            (f"{row.brep_dir}/final.brep", str(OUT / "graphs" / row.design_id), *settings[1:]), cost=row.faces)
         for row in ok.itertuples()
     ]
     with dask_client(params["dask"]) as client:

@@ -2,7 +2,7 @@
 
 The simplified zone graph is searched first (fewer zones, faster); if it yields no exact program,
 the unsimplified graph gets the rest of the budget (face-loop strips can leave zones that no prism
-fills, as on slanted walls). The best program found is rebuilt from its sketches and measured
+fills, as on slanted walls), unless simplification found no face loop and the two graphs are one. The best program found is rebuilt from its sketches and measured
 against the target with B-rep Booleans, whether or not it is exact.
 """
 
@@ -83,7 +83,7 @@ def reconstruct(target_path: str | Path, config: InferConfig = InferConfig(), sa
         search_s += result.seconds
         if best is None or (result.iou, -len(result.steps)) > (best[2].iou, -len(best[2].steps)):
             best = (graph, gen, result)
-        if result.exact:
+        if result.exact or not graph.surface_strip.any():  # no face loop: the full graph is the same
             break
     if best is None:
         raise error

