@@ -2,8 +2,9 @@
 
 The simplified zone graph is searched first (fewer zones, faster); if it yields no exact program,
 the unsimplified graph gets the rest of the budget (face-loop strips can leave zones that no prism
-fills, as on slanted walls), unless simplification found no face loop and the two graphs are one. The best program found is rebuilt from its sketches and measured
-against the target with B-rep Booleans, whether or not it is exact.
+fills, as on slanted walls), unless simplification found no face loop and the two graphs are one.
+The best program found is rebuilt from its sketches and measured against the target with B-rep
+Booleans, whether or not it is exact.
 """
 
 from __future__ import annotations
