@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from zonegraph.design import Design, load_design, parse_design
+from zonegraph.design import Design, load_design
 from zonegraph.design_stats import design_statistics, format_comparison
 from zonegraph.replay import replay
-from zonegraph.synthetic import generate_design
+from zonegraph.synthetic import synthetic_design
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 
@@ -56,8 +56,7 @@ def main() -> None:
     else:
         print(f"real samples not found at {SAMPLES}: skipped")
     t0 = time.perf_counter()
-    synthetic = [parse_design(generate_design(f"synth_{i:05d}", args.seed * 1_000_003 + i), f"synth_{i:05d}")
-                 for i in range(args.synthetic)]
+    synthetic = [synthetic_design(i, args.seed) for i in range(args.synthetic)]
     print(f"\ngenerated {len(synthetic)} synthetic designs in {time.perf_counter() - t0:.1f} s")
     report("synthetic", synthetic)
     print("\n" + format_comparison(design_statistics(synthetic)))

@@ -13,14 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
-from zonegraph.design import load_design, parse_design
+from zonegraph.design import load_design
 from zonegraph.errors import ZoneGraphError
 from zonegraph.infer import make_ranker
 from zonegraph.partition import build_zone_graph
 from zonegraph.proposals import ProposalGenerator
 from zonegraph.replay import replay
 from zonegraph.search import SearchConfig, search
-from zonegraph.synthetic import generate_design
+from zonegraph.synthetic import synthetic_design
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 
@@ -47,6 +47,8 @@ def run(name: str, designs, budget: float, guide: str, max_zones: int) -> None:
     tt = np.array([d[3] for d in per_design if d[2]])
     if len(tt):
         print(f"  time to exact s      median {np.median(tt):.3f}  max {tt.max():.3f}")
+    misses = [d[0] for d in per_design if not d[2]]
+    print(f"  not exact: {', '.join(misses) or 'none'}")
     worst = sorted(per_design, key=lambda d: -d[4])[:3]
     print("  slowest expansions: " + ", ".join(f"{d[0]} ({d[1]} zones, {1e3 * d[4]:.0f} ms)" for d in worst))
 
@@ -61,8 +63,7 @@ def main() -> None:
     if SAMPLES.is_dir():
         run("real samples", [load_design(p) for p in sorted(SAMPLES.glob("*.json"))], args.budget, args.guide,
             args.max_zones)
-    synthetic = (parse_design(generate_design(f"synth_{i:05d}", 2021 * 1_000_003 + i), f"synth_{i:05d}")
-                 for i in range(args.synthetic))
+    synthetic = (synthetic_design(i) for i in range(args.synthetic))
     run("synthetic", synthetic, args.budget, args.guide, args.max_zones)
 
 

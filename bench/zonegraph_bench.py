@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from zonegraph.design import load_design, parse_design
+from zonegraph.design import load_design
 from zonegraph.isolation import Outcome, run_isolated
 from zonegraph.partition import build_zone_graph
 from zonegraph.replay import replay
-from zonegraph.synthetic import generate_design
+from zonegraph.synthetic import synthetic_design
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 
@@ -27,7 +27,7 @@ SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_s
 def _build(source: str, simplify: bool) -> dict:
     if source.startswith("synthetic:"):
         i = int(source.split(":")[1])
-        design = parse_design(generate_design(f"synth_{i:05d}", 2021 * 1_000_003 + i), f"synth_{i:05d}")
+        design = synthetic_design(i)
     else:
         design = load_design(source)
     return build_zone_graph(list(replay(design).bodies), simplify=simplify, samples=512, source=source).summary()

@@ -17,17 +17,13 @@ from zonegraph.dataset import read_dataset
 from zonegraph.design import load_design
 from zonegraph.design_stats import design_statistics, format_comparison
 from zonegraph import synthetic
-from zonegraph.synthetic import generate_design
+from zonegraph.synthetic import design_seed, generate_design, synthetic_id
 
 from .cluster import dask_client
 from .params import load_params
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/designs")
-
-
-def design_seed(base: int, index: int) -> int:
-    return base * 1_000_003 + index
 
 
 def write_design(design_id: str, seed: int, path: str) -> dict:
@@ -43,9 +39,8 @@ def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
     code = code_fingerprint(synthetic)
     jobs = []
     for i in range(count):
-        design_id = f"synth_{i:05d}"
-        s = design_seed(seed, i)
-        jobs.append(Job(design_id, fingerprint(code, s), (design_id, s, str(json_dir / f"{design_id}.json"))))
+        name, s = synthetic_id(i), design_seed(seed, i)
+        jobs.append(Job(name, fingerprint(code, s), (name, s, str(json_dir / f"{name}.json"))))
     with dask_client(dask_cfg) as client:
         records = run_jobs(write_design, jobs, OUT / "records", client, timeout, "generate")
     failed = [r for r in records if r["status"] != "ok"]

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from zonegraph import export, infer as infer_module, partition, program, proposals, search
+from zonegraph import export, infer as infer_module, occ, partition, program, proposals, search
 from zonegraph.infer import InferConfig, infer
 
 from .cluster import dask_client
@@ -55,7 +55,7 @@ def main() -> None:
     replayed = pd.read_parquet("data/replay/manifest.parquet")
     test = replayed[(replayed["split"] == "test") & (replayed["status"] == "ok")]
     zones = pd.read_parquet("data/zonegraphs/manifest.parquet").set_index("design_id")["zones"].fillna(0)
-    code = code_fingerprint(partition, proposals, search, program, export, infer_module)
+    code = code_fingerprint(occ, partition, proposals, search, program, export, infer_module)
     jobs = []
     for guide in cfg["guides"]:
         config = InferConfig(guide, float(cfg["budget_s"]), int(cfg["k"]), float(cfg["k_decay"]),

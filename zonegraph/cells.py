@@ -12,14 +12,8 @@ from typing import Sequence
 from OCP.BOPAlgo import BOPAlgo_CellsBuilder
 from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 from OCP.TopoDS import TopoDS_Shape
-from OCP.collections import List_TopoDS_Shape
 
-
-def _shape_list(shapes: Sequence[TopoDS_Shape]) -> List_TopoDS_Shape:
-    out = List_TopoDS_Shape()
-    for s in shapes:
-        out.Append(s)
-    return out
+from .occ import shape_list
 
 
 def fuse_zones(zones: Sequence[TopoDS_Shape], selected: Sequence[int]) -> TopoDS_Shape:
@@ -32,7 +26,7 @@ def fuse_zones(zones: Sequence[TopoDS_Shape], selected: Sequence[int]) -> TopoDS
     if builder.HasErrors():
         raise RuntimeError("cells builder failed")
     for i in selected:
-        builder.AddToResult(_shape_list([zones[i]]), _shape_list([]), 1, False)
+        builder.AddToResult(shape_list([zones[i]]), shape_list([]), 1, False)
     builder.RemoveInternalBoundaries()
     unify = ShapeUpgrade_UnifySameDomain(builder.Shape(), True, True, True)
     unify.Build()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Sequence
+
 import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRepBndLib import BRepBndLib
@@ -55,6 +57,14 @@ def shapes_of(items: ShapeList) -> list[TopoDS_Shape]:
     while not rest.IsEmpty():
         out.append(rest.First())
         rest.RemoveFirst()
+    return out
+
+
+def shape_list(shapes: Sequence[TopoDS_Shape]) -> ShapeList:
+    """An OCP list of ``shapes`` (what OCCT's builders take)."""
+    out = ShapeList()
+    for shape in shapes:
+        out.Append(shape)
     return out
 
 

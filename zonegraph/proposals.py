@@ -20,10 +20,9 @@ from __future__ import annotations
 import enum
 import itertools
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from .zone_graph import ZoneGraph
 
@@ -47,14 +46,14 @@ class Proposal:
     zones: np.ndarray  # bool (Z,): the extrusion volume X
     op: Op
 
-    @property
+    @cached_property
     def key(self) -> tuple[bytes, int]:
         """Identity of the operation on the canvas (the same volume from other sketches is equal)."""
         return np.packbits(self.zones).tobytes(), int(self.op)
 
-    @property
+    @cached_property
     def inverse_key(self) -> tuple[bytes, int]:
-        return np.packbits(self.zones).tobytes(), -int(self.op)
+        return self.key[0], -int(self.op)
 
     def apply(self, canvas: np.ndarray) -> np.ndarray:
         return canvas | self.zones if self.op is Op.UNION else canvas & ~self.zones
@@ -70,6 +69,7 @@ class ProposalGenerator:
         planes = graph.planes
         self.pairs = self._plane_pairs(planes)
         self.faces_on = {int(s): np.flatnonzero(graph.face_surface == s) for s in planes}
+        self._links_on = self._links_by_plane(planes)
         self._zone_faces = self._faces_of_zones()
         self._sweeps: dict[tuple[int, int, int], np.ndarray | None] = {}
         self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
@@ -86,6 +86,15 @@ class ProposalGenerator:
             if abs(g.surface_offset[e] * float(ns @ ne) - g.surface_offset[s]) > MIN_DISTANCE:
                 pairs.append((s, e))
         return pairs
+
+    def _links_by_plane(self, planes: np.ndarray) -> dict[int, list[tuple[int, int]]]:
+        """Face links (edge-sharing faces, always on one surface) grouped by their plane."""
+        out: dict[int, list[tuple[int, int]]] = {int(s): [] for s in planes}
+        for a, b in self.graph.face_links.tolist():
+            plane = int(self.graph.face_surface[a])
+            if plane in out:
+                out[plane].append((a, b))
+        return out
 
     def direction(self, s: int, e: int) -> np.ndarray:
         """The extrusion vector d from plane s to plane e."""
@@ -157,11 +166,11 @@ class ProposalGenerator:
 
     # ------------------------------------------------------------------------ proposals
 
-    def sketches(self, faces: np.ndarray) -> list[tuple[int, ...]]:
-        """Candidate sketches from one group of faces on a plane (components, their unions)."""
+    def sketches(self, faces: np.ndarray, s: int) -> list[tuple[int, ...]]:
+        """Candidate sketches from one group of faces on plane s (components, their unions)."""
         if not len(faces):
             return []
-        comps = self._components(faces)
+        comps = self._components(faces, s)
         n = len(comps)
         sizes = set(range(1, min(self.level, n) + 1)) | set(range(max(n - self.level, 1), n + 1))
         out = []
@@ -170,16 +179,26 @@ class ProposalGenerator:
                 out.append(tuple(sorted(f for c in combo for f in comps[c])))
         return out
 
-    def _components(self, faces: np.ndarray) -> list[list[int]]:
-        index = {int(f): i for i, f in enumerate(faces)}
-        links = self.graph.face_links
-        mask = np.isin(links[:, 0], faces) & np.isin(links[:, 1], faces)
-        pairs = links[mask]
-        rows = [index[int(a)] for a in pairs[:, 0]]
-        cols = [index[int(b)] for b in pairs[:, 1]]
-        adj = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(faces),) * 2)
-        n, labels = connected_components(adj, directed=False)
-        return [sorted(int(faces[i]) for i in np.flatnonzero(labels == c)) for c in range(n)]
+    def _components(self, faces: np.ndarray, s: int) -> list[list[int]]:
+        """Edge-connected components of ``faces`` on plane s, each sorted, ordered by first face.
+
+        A union-find over the plane's own links: this runs for every group of every state, and
+        building a sparse matrix per call cost more than the rest of an expansion."""
+        parent = {int(f): int(f) for f in faces}
+
+        def root(f: int) -> int:
+            while parent[f] != f:
+                parent[f] = parent[parent[f]]
+                f = parent[f]
+            return f
+
+        for a, b in self._links_on[s]:
+            if a in parent and b in parent:
+                parent[root(a)] = root(b)
+        comps: dict[int, list[int]] = {}
+        for f in parent:
+            comps.setdefault(root(f), []).append(f)
+        return sorted(sorted(c) for c in comps.values())
 
     def extrusion(self, faces: tuple[int, ...], s: int, e: int) -> np.ndarray | None:
         volume = np.zeros(self.graph.n_zones, bool)
@@ -206,7 +225,7 @@ class ProposalGenerator:
                 faces[valid & (in_t | ~in_c)],
             )
             for group in groups:
-                for sketch in self.sketches(group):
+                for sketch in self.sketches(group, s):
                     volume = self.extrusion(sketch, s, e)
                     if volume is None or not volume.any():
                         continue

@@ -18,7 +18,7 @@ from build123d import Face, GeomType, Shape, Solid
 
 from .design import (
     Arc, Circle, Curve, Design, Ellipse, Extent, ExtentType, Extrude, Frame, Line, Loop, Nurbs,
-    Operation, Profile, ProfileRef, Sketch, design_to_json,
+    Operation, Profile, ProfileRef, Sketch, design_to_json, parse_design,
 )
 from .errors import ZoneGraphError
 from .profiles import profile_faces
@@ -357,6 +357,22 @@ def sample_length(rng: np.random.Generator, cfg: SyntheticConfig) -> int:
     n = np.arange(2, cfg.max_extrudes + 1)
     w = cfg.length_decay ** (n - 2)
     return int(rng.choice(n, p=w / w.sum()))
+
+
+def synthetic_id(index: int) -> str:
+    return f"synth_{index:05d}"
+
+
+def design_seed(base: int, index: int) -> int:
+    """The seed of design ``index`` in the set seeded ``base``: each design is reproducible alone."""
+    return base * 1_000_003 + index
+
+
+def synthetic_design(index: int, base_seed: int = 2021) -> Design:
+    """Design ``index`` of the set seeded ``base_seed`` (``params.yaml: synthetic.seed``), exactly as
+    the ``generate`` stage writes it; the benchmarks use it to rebuild the same designs."""
+    name = synthetic_id(index)
+    return parse_design(generate_design(name, design_seed(base_seed, index)), name)
 
 
 def generate_design(design_id: str, seed: int, cfg: SyntheticConfig = SyntheticConfig()) -> dict:
