@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from zonegraph.design import Design, load_design
-from zonegraph.design_stats import design_statistics, format_comparison
-from zonegraph.replay import replay
-from zonegraph.synthetic import synthetic_design
+from zonegraph.data.design import Design, load_design
+from zonegraph.data.stats import design_statistics, format_comparison
+from zonegraph.data.replay import replay
+from zonegraph.data.synthetic import synthetic_design
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 

@@ -13,14 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
-from zonegraph.design import load_design
+from zonegraph.data.design import load_design
 from zonegraph.errors import ZoneGraphError
-from zonegraph.infer import make_ranker
-from zonegraph.partition import build_zone_graph
-from zonegraph.proposals import ProposalGenerator
-from zonegraph.replay import replay
-from zonegraph.search import SearchConfig, search
-from zonegraph.synthetic import synthetic_design
+from zonegraph.sequence.rankers import make_ranker
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.sequence.proposals import ProposalGenerator
+from zonegraph.data.replay import replay
+from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.data.synthetic import synthetic_design
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 

@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from zonegraph.design import load_design
+from zonegraph.data.design import load_design
 from zonegraph.isolation import Outcome, run_isolated
-from zonegraph.partition import build_zone_graph
-from zonegraph.replay import replay
-from zonegraph.synthetic import synthetic_design
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.data.replay import replay
+from zonegraph.data.synthetic import synthetic_design
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 

@@ -13,11 +13,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from zonegraph.dataset import read_dataset
-from zonegraph.design import load_design
-from zonegraph.design_stats import design_statistics, format_comparison
-from zonegraph import synthetic
-from zonegraph.synthetic import design_seed, generate_design, synthetic_id
+from zonegraph.data.dataset import read_dataset
+from zonegraph.data.design import load_design
+from zonegraph.data.stats import design_statistics, format_comparison
+from zonegraph.data.synthetic import design_seed, generate_design, synthetic_id
 
 from .cluster import dask_client
 from .params import load_params
@@ -36,7 +35,7 @@ def write_design(design_id: str, seed: int, path: str) -> dict:
 def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
     json_dir = OUT / "json"
     json_dir.mkdir(parents=True, exist_ok=True)
-    code = code_fingerprint(synthetic)
+    code = code_fingerprint("generate")
     jobs = []
     for i in range(count):
         name, s = synthetic_id(i), design_seed(seed, i)

@@ -15,8 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from zonegraph import export, infer as infer_module, occ, partition, program, proposals, search
-from zonegraph.infer import InferConfig, infer
+from zonegraph.reconstruction import InferConfig, infer
 
 from .cluster import dask_client
 from .params import load_params
@@ -55,7 +54,7 @@ def main() -> None:
     replayed = pd.read_parquet("data/replay/manifest.parquet")
     test = replayed[(replayed["split"] == "test") & (replayed["status"] == "ok")]
     zones = pd.read_parquet("data/zonegraphs/manifest.parquet").set_index("design_id")["zones"].fillna(0)
-    code = code_fingerprint(occ, partition, proposals, search, program, export, infer_module)
+    code = code_fingerprint("reconstruct")
     jobs = []
     for guide in cfg["guides"]:
         config = InferConfig(guide, float(cfg["budget_s"]), int(cfg["k"]), float(cfg["k_decay"]),
@@ -63,7 +62,7 @@ def main() -> None:
         for row in test.itertuples():
             brep = f"{row.brep_dir}/final.brep"
             graph = Path("data/zonegraphs/graphs") / row.design_id
-            jobs.append(Job(f"{guide}__{row.design_id}", fingerprint(code, repr(config), files=(brep,)),
+            jobs.append(Job(f"{guide}__{row.design_id}", fingerprint(code, repr(config), files=(brep, graph)),
                             (brep, str(OUT / guide / row.design_id), config, str(graph)),
                             cost=float(zones.get(row.design_id, 0))))
     with dask_client(params["dask"]) as client:

@@ -12,11 +12,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from zonegraph import design, profiles
-from zonegraph import replay as replay_module
-from zonegraph.design import load_design
-from zonegraph.replay import replay
-from zonegraph.shapes import write_brep
+from zonegraph.data.design import load_design
+from zonegraph.data.replay import replay
+from zonegraph.geometry.shapes import write_brep
 
 from .cluster import dask_client
 from .params import load_params
@@ -49,7 +47,7 @@ def replay_design(path: str, out_dir: str) -> dict:
 def main() -> None:
     params = load_params()
     index = pd.read_parquet("data/designs/index.parquet")
-    code = code_fingerprint(design, profiles, replay_module)
+    code = code_fingerprint("replay")
     jobs = [
         Job(row.design_id, fingerprint(code, files=(row.path,)),
             (row.path, str(OUT / "breps" / row.design_id)))

@@ -13,9 +13,9 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from types import ModuleType
 from typing import Any, Callable
 
+import yaml
 from distributed import Client, as_completed
 from tqdm import tqdm
 
@@ -30,16 +30,44 @@ class Job:
     cost: float = 0.0  # expected run time, any scale: the costliest jobs start first
 
 
+PROJECT = Path(__file__).resolve().parents[1]  # dvc.yaml and the code live here, whatever the cwd
+CODE_ROOTS = ("zonegraph", "pipelines", "training", "eval")
+
+
+def _tree_files(path: Path) -> list[Path]:
+    """A file, or every file under a folder in a stable order (caches and bytecode left out)."""
+    if path.is_file():
+        return [path]
+    return sorted(f for f in path.rglob("*") if f.is_file() and "__pycache__" not in f.parts
+                  and f.suffix not in {".pyc", ".tmp"})
+
+
 def fingerprint(*parts: Any, files: tuple[str | Path, ...] = ()) -> str:
+    """A hash of plain values and of the bytes (and relative names) of files and whole folders."""
     h = hashlib.sha1(json.dumps(parts, sort_keys=True, default=str).encode())
     for f in files:
-        h.update(Path(f).read_bytes())
+        root = Path(f)
+        for path in _tree_files(root):
+            h.update(str(path.relative_to(root)).encode())
+            h.update(path.read_bytes())
     return h.hexdigest()
 
 
-def code_fingerprint(*modules: ModuleType) -> str:
-    """A hash of the modules' source: records made by other code are recomputed, not reused."""
-    return fingerprint(files=tuple(m.__file__ for m in modules))
+def stage_code(stage: str, root: str | Path = PROJECT) -> tuple[str, ...]:
+    """The code a stage depends on: its ``dvc.yaml`` deps under the code roots (files or folders).
+
+    ``dvc.yaml`` is the one list of a stage's code: DVC reruns the stage when it changes, and
+    :func:`code_fingerprint` hashes the same paths into every record, so that a record made by
+    other code is recomputed rather than reused."""
+    root = Path(root)
+    with open(root / "dvc.yaml") as f:
+        deps = yaml.safe_load(f)["stages"][stage].get("deps", [])
+    return tuple(str(root / d) for d in deps if Path(d).parts[0] in CODE_ROOTS)
+
+
+def code_fingerprint(stage: str, root: str | Path = PROJECT) -> str:
+    """A hash of all the source a stage's records depend on (see :func:`stage_code`)."""
+    return fingerprint(stage, files=stage_code(stage, root))
 
 
 def _execute(fn: Callable, job: Job, timeout: float | None) -> dict:

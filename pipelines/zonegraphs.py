@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from zonegraph import extension, face_loops, normalize, occ, partition, zone_graph, zone_io
 from zonegraph.jobs import build_and_save
 
 from .cluster import dask_client
@@ -29,7 +28,7 @@ def main() -> None:
     cfg = params["zonegraph"]
     replayed = pd.read_parquet("data/replay/manifest.parquet")
     ok = replayed[replayed["status"] == "ok"]
-    code = code_fingerprint(extension, face_loops, normalize, occ, partition, zone_graph, zone_io)
+    code = code_fingerprint("zonegraphs")
     settings = (code, bool(cfg["simplify"]), int(cfg["samples"]), int(cfg["seed"]))
     jobs = [
         Job(row.design_id, fingerprint(*settings, files=(f"{row.brep_dir}/final.brep",)),

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from zonegraph.shapes import read_solids
+from zonegraph.geometry.shapes import read_solids
 
 
 SCRIPT = Path(sys.executable).parent / "zonegraph"

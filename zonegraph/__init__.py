@@ -1,8 +1,85 @@
 """zonegraph: recover editable sketch + extrude programs from B-rep solids with zone graphs.
 
-Fusion 360 Gallery replay (``design``, ``profiles``, ``replay``), zone graphs (``partition``,
-``zone_graph``, ``zone_io``), search (``proposals``, ``search``, ``program``) and export
-(``export``, ``infer``). Geometry goes through build123d and OCP; there is no torch import here.
+After Xu et al., *Inferring CAD Modeling Sequences Using Zone Graphs* (CVPR 2021). The layers,
+each a sub-package that imports only the ones before it:
+
+- :mod:`zonegraph.geometry`: OCP/build123d helpers, B-rep I/O, normalisation;
+- :mod:`zonegraph.data`: the Fusion 360 Gallery design model, exact replay, synthetic designs;
+- :mod:`zonegraph.zones`: zone graphs (face extension, general fuse, the :class:`ZoneGraph`);
+- :mod:`zonegraph.sequence`: proposals, rankers, best-first search, programs;
+- :mod:`zonegraph.export`: editable scripts, Fusion JSON, STEP and PNG;
+- on top: :mod:`zonegraph.reconstruction` (:func:`infer`), :mod:`zonegraph.cli`,
+  :mod:`zonegraph.isolation` and :mod:`zonegraph.errors` (used by every layer).
+
+Typical use::
+
+    import zonegraph as zg
+    graph = zg.build_zone_graph(zg.load_target("part.step"))
+    result = zg.search(graph, zg.HeuristicRanker(), zg.SearchConfig(budget_s=10))
+    zg.infer("part.step", "out/", zg.InferConfig(budget_s=20))   # search, rebuild, verify, export
+
+The public names below are imported on first use, so ``import zonegraph`` stays cheap (the
+geometry kernel loads only when a name that needs it is touched). There is no torch import here.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
 __version__ = "0.1.0"
+
+_EXPORTS = {
+    "ZoneGraphError": "zonegraph.errors",
+    "InputError": "zonegraph.errors",
+    "DesignError": "zonegraph.errors",
+    "UnsupportedFeatureError": "zonegraph.errors",
+    "Design": "zonegraph.data",
+    "load_design": "zonegraph.data",
+    "replay": "zonegraph.data.replay",
+    "load_target": "zonegraph.data",
+    "ZoneGraph": "zonegraph.zones",
+    "ZoneGraphBuildError": "zonegraph.zones",
+    "build_zone_graph": "zonegraph.zones",
+    "load_zone_graph": "zonegraph.zones",
+    "save_zone_graph": "zonegraph.zones",
+    "Op": "zonegraph.sequence",
+    "Proposal": "zonegraph.sequence",
+    "ProposalGenerator": "zonegraph.sequence",
+    "Ranker": "zonegraph.sequence",
+    "RandomRanker": "zonegraph.sequence",
+    "HeuristicRanker": "zonegraph.sequence",
+    "SearchConfig": "zonegraph.sequence",
+    "SearchResult": "zonegraph.sequence",
+    "search": "zonegraph.sequence",
+    "InferConfig": "zonegraph.reconstruction",
+    "InferResult": "zonegraph.reconstruction",
+    "Reconstruction": "zonegraph.reconstruction",
+    "reconstruct": "zonegraph.reconstruction",
+    "infer": "zonegraph.reconstruction",
+}
+
+__all__ = sorted(_EXPORTS)
+
+if TYPE_CHECKING:
+    from zonegraph.data import Design, load_design, load_target
+    from zonegraph.data.replay import replay
+    from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError, ZoneGraphError
+    from zonegraph.reconstruction import InferConfig, InferResult, Reconstruction, infer, reconstruct
+    from zonegraph.sequence import (HeuristicRanker, Op, Proposal, ProposalGenerator, RandomRanker, Ranker,
+                                    SearchConfig, SearchResult, search)
+    from zonegraph.zones import ZoneGraph, ZoneGraphBuildError, build_zone_graph, load_zone_graph, save_zone_graph
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name from its sub-package on first use (PEP 562)."""
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'zonegraph' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -12,15 +12,15 @@ import sys
 from pathlib import Path
 from typing import Callable, Sequence
 
-from .errors import ZoneGraphError
+from zonegraph.errors import ZoneGraphError
 
 EXIT_USER_ERROR = 2
 
 
 def _cmd_replay(args: argparse.Namespace) -> int:
-    from .design import load_design
-    from .replay import replay
-    from .shapes import write_step
+    from zonegraph.data.design import load_design
+    from zonegraph.data.replay import replay
+    from zonegraph.geometry.shapes import write_step
 
     design = load_design(args.design)
     result = replay(design)
@@ -43,8 +43,8 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
 
 def _cmd_build(args: argparse.Namespace) -> int:
-    from .isolation import run_isolated
-    from .jobs import build_and_save
+    from zonegraph.isolation import run_isolated
+    from zonegraph.jobs import build_and_save
 
     outcome = run_isolated(build_and_save, (args.target, args.out, not args.no_simplify, args.samples, args.seed),
                            timeout=args.timeout)
@@ -61,8 +61,8 @@ def _cmd_build(args: argparse.Namespace) -> int:
 
 
 def _cmd_infer(args: argparse.Namespace) -> int:
-    from .infer import InferConfig, infer
-    from .isolation import run_isolated
+    from zonegraph.reconstruction import InferConfig, infer
+    from zonegraph.isolation import run_isolated
 
     config = InferConfig(args.guide, args.budget, args.k, args.k_decay, args.max_depth, args.seed, args.level)
     timeout = args.timeout or 3 * args.budget + 300  # the build and the export are not budgeted

@@ -14,7 +14,7 @@ import traceback
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from .errors import ZoneGraphError
+from zonegraph.errors import ZoneGraphError
 
 
 @dataclass(frozen=True)

@@ -3,9 +3,9 @@ returns only small plain data (the geometry goes to files)."""
 
 from __future__ import annotations
 
-from .partition import build_zone_graph
-from .targets import load_target
-from .zone_io import save_zone_graph
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.data.targets import load_target
+from zonegraph.zones.storage import save_zone_graph
 
 
 def build_and_save(target: str, out: str, simplify: bool = True, samples: int = 512, seed: int = 0) -> dict:

@@ -1,0 +1,85 @@
+"""Proposal rules on small hand-made parts, and search invariants."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from build123d import Box, Cylinder, Pos
+
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.sequence.proposals import Op, ProposalGenerator
+from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.sequence.rankers import HeuristicRanker, RandomRanker, zone_iou
+
+
+def graph_of(part, simplify=True):
+    return build_zone_graph(part, simplify=simplify, samples=0)
+
+
+def test_plate_with_hole_needs_a_subtraction_or_a_ring():
+    g = graph_of(Box(4, 4, 1) - Cylinder(1, 1))
+    gen = ProposalGenerator(g)
+    empty = np.zeros(g.n_zones, bool)
+    first = gen.proposals(empty)
+    assert all(p.op is Op.UNION for p in first)  # nothing to subtract from an empty canvas
+    assert any(np.array_equal(p.zones, g.zone_inside) for p in first)  # the ring itself
+    plate = next(p for p in first if p.zones.all())  # or the whole plate...
+    holes = [p for p in gen.proposals(plate.apply(empty)) if p.op is Op.SUBTRACT]
+    assert any(np.array_equal(p.apply(plate.apply(empty)), g.zone_inside) for p in holes)  # ...then the hole
+
+
+def test_step_needs_two_unions():
+    part = Box(4, 4, 1) + Pos(0, 0, 1) * Box(2, 2, 1)  # a block on a plate: no single prism
+    g = graph_of(part)
+    gen = ProposalGenerator(g)
+    empty = np.zeros(g.n_zones, bool)
+    assert not any(np.array_equal(p.apply(empty), g.zone_inside) for p in gen.proposals(empty))
+    result = search(g, HeuristicRanker(), SearchConfig(budget_s=10), gen)
+    assert result.exact and [p.op for p in result.steps] == [Op.UNION, Op.UNION]
+
+
+def test_no_proposal_leaves_the_canvas_unchanged():
+    g = graph_of(Box(4, 4, 1) - Cylinder(1, 1), simplify=False)
+    gen = ProposalGenerator(g)
+    for canvas in (np.zeros(g.n_zones, bool), g.zone_inside.copy(), np.ones(g.n_zones, bool)):
+        props = gen.proposals(canvas)
+        assert props and all(not np.array_equal(p.apply(canvas), canvas) for p in props)
+        for p in props:  # and each proposal's type matches where its volume lies
+            if p.op is Op.UNION:
+                assert (p.zones & ~canvas).any()
+            else:
+                assert (p.zones & canvas).any()
+
+
+def test_sweeps_fill_their_prisms_exactly():
+    g = graph_of(Box(6, 4, 2) - Pos(0, 0, 0.5) * Box(2, 1, 1), simplify=False)
+    gen = ProposalGenerator(g)
+    gen.proposals(np.zeros(g.n_zones, bool))
+    for (face, s, e), zones in gen._sweeps.items():
+        if zones is not None:
+            length = np.linalg.norm(gen.direction(s, e))
+            assert g.zone_volume[zones].sum() == pytest.approx(g.face_area[face] * length, rel=1e-4)
+
+
+def test_search_never_undoes_its_own_steps():
+    g = graph_of(Box(4, 4, 1) + Pos(0, 0, 1) * Box(2, 2, 1) - Cylinder(0.5, 4), simplify=False)
+    result = search(g, RandomRanker(seed=3), SearchConfig(budget_s=3))
+    keys = [p.key for p in result.steps]
+    assert not any(p.inverse_key in keys[:i] for i, p in enumerate(result.steps))
+    assert result.iou == pytest.approx(zone_iou(g, result.canvas, g.zone_inside))
+    assert [t for t, _ in result.trace] == sorted(t for t, _ in result.trace)
+
+
+def test_heuristic_prefers_agreeing_proposals():
+    g = graph_of(Box(4, 4, 1) - Cylinder(1, 1))
+    gen = ProposalGenerator(g)
+    empty = np.zeros(g.n_zones, bool)
+    props = gen.proposals(empty)
+    scores = HeuristicRanker().score(g, empty, props)
+    assert np.array_equal(props[int(np.argmax(scores))].zones, g.zone_inside)
+
+
+def test_random_ranker_is_seeded():
+    g = graph_of(Box(4, 4, 1) - Cylinder(1, 1))
+    runs = [search(g, RandomRanker(seed=5), SearchConfig(budget_s=5)) for _ in range(2)]
+    assert [[p.key for p in r.steps] for r in runs][0] == [[p.key for p in r.steps] for r in runs][1]

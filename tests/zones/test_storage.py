@@ -1,0 +1,101 @@
+"""Zone graph storage round trip and the ``zonegraph build`` command."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from build123d import Box, Rectangle, export_step
+
+from zonegraph.errors import InputError
+from zonegraph.jobs import build_and_save
+from zonegraph.geometry.occ import volume_props
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.data.targets import load_target
+from zonegraph.zones.model import ZoneGraphBuildError
+from zonegraph.zones.storage import load_zone_graph, save_zone_graph
+
+SCRIPT = Path(sys.executable).parent / "zonegraph"
+
+
+def test_round_trip_is_equal(samples_dir, tmp_path):
+    graph = build_zone_graph(load_target(samples_dir / "Pattern2_6c40bf33_0000.json"), samples=64, seed=3)
+    loaded = load_zone_graph(save_zone_graph(graph, tmp_path / "g"))
+    for f in dataclasses.fields(graph):
+        a, b = getattr(graph, f.name), getattr(loaded, f.name)
+        if f.name in ("zone_points", "zone_normals"):  # stored as float16: network inputs, not geometry
+            np.testing.assert_allclose(a, b, atol=2e-3)
+        elif f.name == "solids":
+            assert [volume_props(s)[0] for s in a] == pytest.approx([volume_props(s)[0] for s in b], rel=1e-12)
+        elif isinstance(a, np.ndarray):
+            np.testing.assert_array_equal(a, b)
+        else:
+            assert a == b, f.name
+
+
+def test_samples_are_seeded(samples_dir):
+    target = load_target(samples_dir / "Couch.json")
+    a, b = (build_zone_graph(target, samples=32, seed=s) for s in (1, 1))
+    c = build_zone_graph(target, samples=32, seed=2)
+    np.testing.assert_array_equal(a.zone_points, b.zone_points)
+    assert not np.array_equal(a.zone_points, c.zone_points)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(InputError, match="no such file"):
+        build_and_save(str(tmp_path / "absent.step"), str(tmp_path / "out"))
+
+
+def test_empty_and_corrupt_step(tmp_path):
+    empty, corrupt = tmp_path / "empty.step", tmp_path / "corrupt.step"
+    empty.write_text("")
+    corrupt.write_text("ISO-10303-21;\nthis is not STEP\n")
+    with pytest.raises(InputError, match="empty"):
+        load_target(empty)
+    with pytest.raises(InputError, match="corrupt"):
+        load_target(corrupt)
+
+
+def test_sheet_or_wire_is_not_a_solid(tmp_path):
+    sheet = tmp_path / "sheet.step"
+    export_step(Rectangle(2, 1).faces()[0], str(sheet))
+    with pytest.raises(InputError, match="not a solid"):
+        load_target(sheet)
+    with pytest.raises(ZoneGraphBuildError) as err:
+        build_zone_graph(Rectangle(2, 1).faces()[0])
+    assert err.value.status == "not_a_solid"
+    with pytest.raises(ZoneGraphBuildError) as err:
+        build_zone_graph(Rectangle(2, 1).wire())
+    assert err.value.status == "not_a_solid"
+
+
+@pytest.mark.skipif(not SCRIPT.exists(), reason=f"console script not installed at {SCRIPT}")
+def test_cli_build_prints_counts_and_writes_the_graph(tmp_path):
+    part = tmp_path / "plate.step"
+    export_step(Box(4, 4, 1) - Box(1, 1, 1), str(part))
+    out = tmp_path / "graph"
+    proc = subprocess.run([str(SCRIPT), "build", str(part), "--out", str(out)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "status ok, 2 zones (1 inside)" in proc.stdout  # the through hole is one face loop
+    graph = load_zone_graph(out)
+    assert graph.zone_inside.sum() >= 1 and (out / "zones.brep").stat().st_size > 0
+
+
+@pytest.mark.skipif(not SCRIPT.exists(), reason=f"console script not installed at {SCRIPT}")
+@pytest.mark.parametrize("args, message", [
+    (["absent.step"], "no such file"),
+    (["sheet.step"], "not a solid"),
+    (["plate.step", "--timeout", "0.01"], "timeout"),
+])
+def test_cli_build_errors_are_one_line(tmp_path, args, message):
+    export_step(Rectangle(2, 1).faces()[0], str(tmp_path / "sheet.step"))
+    export_step(Box(4, 4, 1) - Box(1, 1, 1), str(tmp_path / "plate.step"))
+    args = [str(tmp_path / args[0]), *args[1:]]
+    proc = subprocess.run([str(SCRIPT), "build", *args, "--out", str(tmp_path / "o")], capture_output=True, text=True)
+    assert proc.returncode == 2
+    lines = [line for line in proc.stderr.splitlines() if line.startswith("zonegraph:")]
+    assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr

@@ -1,0 +1,114 @@
+"""Best-first search with top-k and backtracking over zone-graph canvases (paper sec. 4, Alg. 2).
+
+A state is only a canvas (a bool vector over zones): the geometry never changes. At each state all
+proposals are scored at once by a ranker, the top k are kept (k may shrink with depth, as the
+paper's 15 - 0.5 per level), the best is explored first, and a dead end (no proposal, depth limit,
+a canvas seen before) backs up to the next of the top k. The search stops when the canvas equals
+the target or a budget (wall clock, expansions) is spent, and returns the best canvas seen: highest
+zone IoU, then fewest steps. The anytime trace of (seconds, best IoU) feeds IoU-vs-time curves.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Iterator
+
+import numpy as np
+
+from zonegraph.sequence.proposals import Proposal, ProposalGenerator
+from zonegraph.sequence.rankers import Ranker, zone_iou
+from zonegraph.zones.model import ZoneGraph
+
+
+@dataclass(frozen=True)
+class SearchConfig:
+    k: int = 5
+    k_decay: float = 0.0  # per depth level: the paper's harder runs used k = 15, decay 0.5
+    max_depth: int = 20
+    budget_s: float = 10.0
+    max_expansions: int | None = None
+
+    def k_at(self, depth: int) -> int:
+        return max(1, int(round(self.k - self.k_decay * depth)))
+
+
+@dataclass
+class SearchResult:
+    exact: bool
+    iou: float
+    steps: list[Proposal]
+    canvas: np.ndarray
+    expansions: int
+    seconds: float
+    time_to_best_s: float
+    trace: list[tuple[float, float]]  # (seconds, best IoU so far)
+    proposals_per_state: list[int]
+    expansion_s: list[float]  # seconds per expansion (proposals + scoring)
+
+
+@dataclass
+class _Frame:
+    canvas: np.ndarray
+    path: list[Proposal]
+    children: Iterator[Proposal]
+
+
+def search(graph: ZoneGraph, ranker: Ranker, config: SearchConfig = SearchConfig(),
+           generator: ProposalGenerator | None = None) -> SearchResult:
+    """Find a proposal sequence whose canvas equals the target's zones."""
+    gen = generator or ProposalGenerator(graph)
+    target = graph.zone_inside.astype(bool)
+    t0 = time.perf_counter()
+    empty = np.zeros(graph.n_zones, bool)
+    best = (zone_iou(graph, empty, target), 0, empty, [])
+    trace = [(0.0, best[0])]
+    time_to_best = 0.0
+    seen = {np.packbits(empty).tobytes()}
+    counts: list[int] = []
+    times: list[float] = []
+
+    def expand(canvas: np.ndarray, path: list[Proposal]) -> Iterator[Proposal]:
+        start = time.perf_counter()
+        used = {p.inverse_key for p in path}
+        props = [p for p in gen.proposals(canvas) if p.key not in used]
+        counts.append(len(props))
+        order = []
+        if props:
+            scores = np.asarray(ranker.score(graph, canvas, props), float)
+            order = np.argsort(-scores, kind="stable")[: config.k_at(len(path))]
+        times.append(time.perf_counter() - start)
+        return iter([props[i] for i in order])
+
+    stack = [_Frame(empty, [], expand(empty, []))]
+    exact = bool(np.array_equal(empty, target))
+    while stack and not exact:
+        elapsed = time.perf_counter() - t0
+        if elapsed > config.budget_s or (config.max_expansions and len(counts) >= config.max_expansions):
+            break
+        frame = stack[-1]
+        child = next(frame.children, None)
+        if child is None:
+            stack.pop()
+            continue
+        canvas = child.apply(frame.canvas)
+        key = np.packbits(canvas).tobytes()
+        if key in seen:
+            continue
+        seen.add(key)
+        path = frame.path + [child]
+        iou = zone_iou(graph, canvas, target)
+        if (iou, -len(path)) > (best[0], -best[1]):
+            best = (iou, len(path), canvas, path)
+            time_to_best = time.perf_counter() - t0
+            trace.append((time_to_best, iou))
+        if np.array_equal(canvas, target):
+            exact = True
+            break
+        if len(path) < config.max_depth:
+            stack.append(_Frame(canvas, path, expand(canvas, path)))
+    return SearchResult(
+        exact=exact, iou=best[0], steps=best[3], canvas=best[2], expansions=len(counts),
+        seconds=time.perf_counter() - t0, time_to_best_s=time_to_best, trace=trace,
+        proposals_per_state=counts, expansion_s=times,
+    )

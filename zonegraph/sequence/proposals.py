@@ -1,0 +1,239 @@
+"""Extrusion proposals from a zone graph (paper sec. 4.1, supplement Alg. 1).
+
+For every ordered pair of parallel planes (start s, end e; d = the vector from s to e), the
+partition faces on s are grouped by the zone just beyond them along d:
+
+1. in the canvas but not the target: can start a subtraction;
+2. in the target but not the canvas: can start a union;
+3. in the target, or in neither: can start a union.
+
+A sketch is a connected component of a group (faces sharing an edge on s), the union of the
+group's components, or (proposal level k) any 1..k or N-k..N of them. Each sketch face is swept
+along d to e through the zones it meets: from the face into the zone beyond it, then across that
+zone's caps (faces facing along d), never its side walls, until plane e. The zones swept must fill
+the prism exactly (volume = face area x |d|, relative 1e-4); a face that fails rejects the whole
+sketch. Sweeps are memoised per (face, s, e): the geometry never changes during search.
+"""
+
+from __future__ import annotations
+
+import enum
+import itertools
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from zonegraph.zones.model import ZoneGraph
+
+PARALLEL_TOL = 1e-9
+MIN_DISTANCE = 1e-5  # normalised units: closer parallel planes are not an extrusion
+PRISM_RTOL = 1e-4
+
+
+class Op(enum.IntEnum):
+    UNION = 1
+    SUBTRACT = -1
+
+
+@dataclass(frozen=True)
+class Proposal:
+    """One candidate operation: extrude ``faces`` on plane ``start`` to plane ``end``."""
+
+    start: int  # surface index of the start plane
+    end: int  # surface index of the end plane
+    faces: tuple[int, ...]  # partition faces of the sketch (sorted)
+    zones: np.ndarray  # bool (Z,): the extrusion volume X
+    op: Op
+
+    @cached_property
+    def key(self) -> tuple[bytes, int]:
+        """Identity of the operation on the canvas (the same volume from other sketches is equal)."""
+        return np.packbits(self.zones).tobytes(), int(self.op)
+
+    @cached_property
+    def inverse_key(self) -> tuple[bytes, int]:
+        return self.key[0], -int(self.op)
+
+    def apply(self, canvas: np.ndarray) -> np.ndarray:
+        return canvas | self.zones if self.op is Op.UNION else canvas & ~self.zones
+
+
+class ProposalGenerator:
+    """Proposals for any canvas of one zone graph, with every canvas-independent part precomputed."""
+
+    def __init__(self, graph: ZoneGraph, level: int = 1):
+        self.graph = graph
+        self.level = level
+        self.target = graph.zone_inside.astype(bool)
+        planes = graph.planes
+        self.pairs = self._plane_pairs(planes)
+        self.faces_on = {int(s): np.flatnonzero(graph.face_surface == s) for s in planes}
+        self._links_on = self._links_by_plane(planes)
+        self._zone_faces = self._faces_of_zones()
+        self._sweeps: dict[tuple[int, int, int], np.ndarray | None] = {}
+        self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
+
+    # ------------------------------------------------------------------ static structure
+
+    def _plane_pairs(self, planes: np.ndarray) -> list[tuple[int, int]]:
+        g = self.graph
+        pairs = []
+        for s, e in itertools.permutations(planes.tolist(), 2):
+            ns, ne = g.surface_normal[s], g.surface_normal[e]
+            if 1 - abs(float(ns @ ne)) > PARALLEL_TOL:
+                continue
+            if abs(g.surface_offset[e] * float(ns @ ne) - g.surface_offset[s]) > MIN_DISTANCE:
+                pairs.append((s, e))
+        return pairs
+
+    def _links_by_plane(self, planes: np.ndarray) -> dict[int, list[tuple[int, int]]]:
+        """Face links (edge-sharing faces, always on one surface) grouped by their plane."""
+        out: dict[int, list[tuple[int, int]]] = {int(s): [] for s in planes}
+        for a, b in self.graph.face_links.tolist():
+            plane = int(self.graph.face_surface[a])
+            if plane in out:
+                out[plane].append((a, b))
+        return out
+
+    def direction(self, s: int, e: int) -> np.ndarray:
+        """The extrusion vector d from plane s to plane e."""
+        g = self.graph
+        n = g.surface_normal[s]
+        return n * (g.surface_offset[e] * float(n @ g.surface_normal[e]) - g.surface_offset[s])
+
+    def _faces_of_zones(self) -> list[np.ndarray]:
+        fz = self.graph.face_zones
+        out: list[list[int]] = [[] for _ in range(self.graph.n_zones)]
+        for f, (a, b) in enumerate(fz):
+            out[a].append(f)
+            if b >= 0:
+                out[b].append(f)
+        return [np.array(x, np.int64) for x in out]
+
+    def _zones_beyond(self, s: int, e: int) -> np.ndarray:
+        """For each face on s: the zone on its d side (-1 if none)."""
+        g = self.graph
+        d = self.direction(s, e)
+        faces = self.faces_on[s]
+        forward = g.face_normal[faces] @ d > 0
+        return np.where(forward, g.face_zones[faces, 1], g.face_zones[faces, 0])
+
+    # -------------------------------------------------------------------------- sweeping
+
+    def sweep(self, face: int, s: int, e: int) -> np.ndarray | None:
+        """Zones of the prism over ``face`` from s to e, or None if they do not fill it exactly."""
+        key = (face, s, e)
+        if key not in self._sweeps:
+            self._sweeps[key] = self._sweep(face, s, e)
+        return self._sweeps[key]
+
+    def _sweep(self, face: int, s: int, e: int) -> np.ndarray | None:
+        g = self.graph
+        d = self.direction(s, e)
+        length = float(np.linalg.norm(d))
+        side_s = 1 if float(g.surface_normal[s] @ d) > 0 else -1
+        side_e = 1 if float(g.surface_normal[e] @ d) > 0 else -1
+        a, b = g.face_zones[face]
+        start = b if float(g.face_normal[face] @ d) > 0 else a
+        if start < 0:
+            return None
+        zones = np.zeros(g.n_zones, bool)
+        stack = [int(start)]
+        while stack:
+            z = stack.pop()
+            if zones[z]:
+                continue
+            if g.plane_side[s, z] != side_s or g.plane_side[e, z] != -side_e:
+                return None  # the zone reaches outside the slab between s and e
+            zones[z] = True
+            for f in self._zone_faces[z]:
+                if g.face_surface[f] == e:
+                    continue
+                n = g.face_normal[f]
+                if not np.isfinite(n[0]):
+                    continue  # curved faces are side walls here
+                fa, fb = g.face_zones[f]
+                outward = n if fa == z else -n  # face normals point from zone a to zone b
+                if float(outward @ d) > PARALLEL_TOL * length:
+                    other = fb if fa == z else fa
+                    if other < 0:
+                        return None
+                    stack.append(int(other))
+        if abs(float(g.zone_volume[zones].sum()) - g.face_area[face] * length) > PRISM_RTOL * g.face_area[face] * length:
+            return None
+        return zones
+
+    # ------------------------------------------------------------------------ proposals
+
+    def sketches(self, faces: np.ndarray, s: int) -> list[tuple[int, ...]]:
+        """Candidate sketches from one group of faces on plane s (components, their unions)."""
+        if not len(faces):
+            return []
+        comps = self._components(faces, s)
+        n = len(comps)
+        sizes = set(range(1, min(self.level, n) + 1)) | set(range(max(n - self.level, 1), n + 1))
+        out = []
+        for size in sorted(sizes):
+            for combo in itertools.combinations(range(n), size):
+                out.append(tuple(sorted(f for c in combo for f in comps[c])))
+        return out
+
+    def _components(self, faces: np.ndarray, s: int) -> list[list[int]]:
+        """Edge-connected components of ``faces`` on plane s, each sorted, ordered by first face.
+
+        A union-find over the plane's own links: this runs for every group of every state, and
+        building a sparse matrix per call cost more than the rest of an expansion."""
+        parent = {int(f): int(f) for f in faces}
+
+        def root(f: int) -> int:
+            while parent[f] != f:
+                parent[f] = parent[parent[f]]
+                f = parent[f]
+            return f
+
+        for a, b in self._links_on[s]:
+            if a in parent and b in parent:
+                parent[root(a)] = root(b)
+        comps: dict[int, list[int]] = {}
+        for f in parent:
+            comps.setdefault(root(f), []).append(f)
+        return sorted(sorted(c) for c in comps.values())
+
+    def extrusion(self, faces: tuple[int, ...], s: int, e: int) -> np.ndarray | None:
+        volume = np.zeros(self.graph.n_zones, bool)
+        for f in faces:
+            swept = self.sweep(f, s, e)
+            if swept is None:
+                return None
+            volume |= swept
+        return volume
+
+    def proposals(self, canvas: np.ndarray) -> list[Proposal]:
+        """Every distinct (volume, operation) reachable from ``canvas`` by one extrusion."""
+        target = self.target
+        seen: dict[tuple[bytes, int], Proposal] = {}
+        for s, e in self.pairs:
+            faces = self.faces_on[s]
+            beyond = self._beyond[(s, e)]
+            valid = beyond >= 0
+            z = np.where(valid, beyond, 0)
+            in_c, in_t = canvas[z] & valid, target[z] & valid
+            groups = (
+                faces[in_c & ~in_t],
+                faces[in_t & ~in_c],
+                faces[valid & (in_t | ~in_c)],
+            )
+            for group in groups:
+                for sketch in self.sketches(group, s):
+                    volume = self.extrusion(sketch, s, e)
+                    if volume is None or not volume.any():
+                        continue
+                    inside = bool((volume & ~canvas).sum() == 0)
+                    outside = not (volume & canvas).any()
+                    ops = [Op.SUBTRACT] if inside else [Op.UNION] if outside else [Op.UNION, Op.SUBTRACT]
+                    for op in ops:
+                        p = Proposal(s, e, sketch, volume, op)
+                        if not np.array_equal(p.apply(canvas), canvas):
+                            seen.setdefault(p.key, p)
+        return list(seen.values())

@@ -1,0 +1,378 @@
+"""Build a zone graph: normalise, extend faces, one general fuse, then label and connect zones.
+
+The general fuse (``BOPAlgo_Builder``) of the box with every extended sheet splits the box into
+zones that share their partition faces, so adjacency falls out of a face -> solid ancestor map, and
+the fuse history says which surface each face lies on. Zones are classified with one verified
+interior point each (a point stepped inward from the zone's largest mesh triangle and confirmed by
+a classifier on the zone itself): centroids of non-convex zones, such as the ring around a hole,
+can lie outside them.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Sequence
+
+import numpy as np
+from OCP.BOPAlgo import BOPAlgo_Builder
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepClass3d import BRepClass3d_SolidClassifier
+from OCP.BRepMesh import BRepMesh_IncrementalMesh
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+from OCP.GeomAbs import GeomAbs_Cylinder, GeomAbs_Plane
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN, TopAbs_INTERNAL, TopAbs_REVERSED, TopAbs_SOLID
+from OCP.TopoDS import TopoDS, TopoDS_Shape
+
+from zonegraph.zones.extension import ExtendedSurface, SurfaceKind, canonical, extend_faces, parallel
+from zonegraph.geometry.normalize import Normalization
+from zonegraph.geometry.occ import (ShapeList, ancestors, bounds, face_triangles, make_compound, pnt, shape_index, shapes_of, sub_shapes,
+                  surface_props, volume_props, xyz)
+from zonegraph.zones.model import BuildStatus, ZoneGraph, ZoneGraphBuildError
+
+# Fuzzy values of the general fuse, in normalised units, tried in turn: 1e-7..1e-5 leave zone counts
+# unchanged where the fuse works at all, 1e-3 loses zones.
+FUZZY_LADDER = (1e-6, 1e-5, 1e-7)
+MESH_DEFLECTION = 1e-3
+CLASSIFY_TOL = 1e-9
+SIDE_TOL = 1e-6
+
+
+class _Timer:
+    def __init__(self) -> None:
+        self.t = time.perf_counter()
+        self.laps: dict[str, float] = {}
+
+    def lap(self, name: str) -> None:
+        now = time.perf_counter()
+        self.laps[name] = round(self.laps.get(name, 0.0) + now - self.t, 4)
+        self.t = now
+
+
+def _target_shape(target, source: str) -> TopoDS_Shape:
+    """The solids of ``target`` (a build123d shape, a TopoDS shape or a list of either)."""
+    items = target if isinstance(target, (list, tuple)) else [target]
+    shapes = [getattr(t, "wrapped", t) for t in items]
+    if not shapes or any(s is None or s.IsNull() for s in shapes):
+        raise ZoneGraphBuildError(BuildStatus.INVALID_INPUT, source, "empty shape")
+    solids = [s for shape in shapes for s in sub_shapes(shape, TopAbs_SOLID)]
+    if not solids:
+        raise ZoneGraphBuildError(BuildStatus.NOT_A_SOLID, source, "no solid in the shape (a sheet, wire or empty file?)")
+    return make_compound(solids)
+
+
+class _Unsplit:
+    """Stands in for the fuse when no sheet cuts the box (a box-shaped target): one zone."""
+
+    def __init__(self, box_solid: TopoDS_Shape):
+        self.box_solid = box_solid
+
+    def Shape(self) -> TopoDS_Shape:  # noqa: N802 (mirrors BOPAlgo_Builder)
+        return self.box_solid
+
+    def IsDeleted(self, shape) -> bool:  # noqa: N802
+        return False
+
+    def Modified(self, shape) -> ShapeList:  # noqa: N802
+        return ShapeList()
+
+
+def _fuse(box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface], fuzzy: float, source: str):
+    if not any(s.sheets for s in surfaces):
+        return _Unsplit(box_solid)
+    builder = BOPAlgo_Builder()
+    builder.AddArgument(box_solid)
+    for s in surfaces:
+        for sheet in s.sheets:
+            builder.AddArgument(sheet)
+    builder.SetFuzzyValue(fuzzy)
+    builder.SetRunParallel(False)
+    builder.SetNonDestructive(True)
+    builder.Perform()
+    if builder.HasErrors():
+        raise ZoneGraphBuildError(BuildStatus.FUSE_FAILED, source, "general fuse reported errors")
+    return builder
+
+
+def build_zone_graph(target, simplify: bool = True, samples: int = 512, seed: int = 0,
+                     fuzzy: Sequence[float] = FUZZY_LADDER, source: str = "target", keep_solids: bool = True,
+                     check: bool = True) -> ZoneGraph:
+    """The zone graph of ``target``; raises ZoneGraphBuildError with a status on failure.
+
+    The general fuse occasionally fails quietly (it drops splits it cannot compute), which only
+    the invariants reveal; each fuzzy value in ``fuzzy`` is tried in turn until they hold.
+    """
+    timer = _Timer()
+    shape = _target_shape(target, source)
+    norm = Normalization.of(shape)
+    target_n = norm.apply(shape)
+    solids = sub_shapes(target_n, TopAbs_SOLID)
+    target_volume = sum(volume_props(s)[0] for s in solids)
+    if not target_volume > 0:
+        raise ZoneGraphBuildError(BuildStatus.INVALID_INPUT, source, "target has no volume")
+    box = bounds(target_n)
+    surfaces, n_target_faces = extend_faces(target_n, box, simplify)
+    timer.lap("extend_s")
+    info = {"status": "ok", "simplified": simplify, "target_faces": n_target_faces, "target_solids": len(solids)}
+    ladder = [fuzzy] if isinstance(fuzzy, float) else list(fuzzy)
+    for attempt, value in enumerate(ladder):
+        try:
+            graph = _partition(norm, box, target_volume, solids, surfaces, value, samples, seed, source, timer)
+            graph.info.update(info, fuzzy=value, attempts=attempt + 1)
+            if check:
+                graph.check(source)
+            break
+        except ZoneGraphBuildError as exc:
+            if attempt == len(ladder) - 1 or exc.status == BuildStatus.INVALID_INPUT.value:
+                raise
+    if not keep_solids:
+        graph.solids = None
+    graph.info.update(timer.laps, build_s=round(sum(timer.laps.values()), 4))
+    return graph
+
+
+def _partition(norm: Normalization, box: np.ndarray, target_volume: float, solids: list, surfaces: list,
+               fuzzy: float, samples: int, seed: int, source: str, timer: _Timer) -> ZoneGraph:
+    box_solid = BRepPrimAPI_MakeBox(pnt(box[:3]), pnt(box[3:])).Solid()
+    builder = _fuse(box_solid, surfaces, fuzzy, source)
+    timer.lap("fuse_s")
+    topo = _Topology(builder, box_solid, surfaces)
+    timer.lap("topology_s")
+    mesh = _ZoneMesh(topo)
+    interior = mesh.interior_points()
+    inside = _classify(interior, solids)
+    points, normals = mesh.samples(samples, np.random.default_rng(seed))
+    timer.lap("zones_s")
+    graph = ZoneGraph(
+        normalization=norm, box=box, target_volume=target_volume,
+        zone_volume=topo.zone_volume, zone_centroid=topo.zone_centroid, zone_bbox=mesh.zone_bbox(),
+        zone_interior=interior, zone_inside=inside, zone_points=points, zone_normals=normals,
+        face_zones=topo.face_zones, face_area=topo.face_area, face_centroid=topo.face_centroid,
+        face_normal=topo.face_normals(interior), face_surface=topo.face_surface, face_links=topo.face_links(),
+        **_surface_arrays(surfaces), plane_side=mesh.plane_sides(surfaces), solids=topo.zones,
+    )
+    timer.lap("graph_s")
+    return graph
+
+
+# ---------------------------------------------------------------------------------- topology
+
+
+class _Topology:
+    """Zones, partition faces and which surface each face lies on, from the fuse result."""
+
+    def __init__(self, builder: BOPAlgo_Builder | _Unsplit, box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface]):
+        result = builder.Shape()
+        zone_index = shape_index(result, TopAbs_SOLID)
+        self.zones = [TopoDS.Solid(zone_index.FindKey(i)) for i in range(1, zone_index.Size() + 1)]
+        self.compound = make_compound(self.zones)
+        self.zone_index = shape_index(self.compound, TopAbs_SOLID)
+        props = [volume_props(z) for z in self.zones]
+        self.zone_volume = np.array([p[0] for p in props])
+        self.zone_centroid = np.array([p[1] for p in props]).reshape(-1, 3)
+        self.face_map = ancestors(self.compound, TopAbs_FACE, TopAbs_SOLID)
+        self.faces = [TopoDS.Face(self.face_map.FindKey(i)) for i in range(1, self.face_map.Size() + 1)]
+        self.face_zones = self._face_zones()
+        fprops = [surface_props(f) for f in self.faces]
+        self.face_area = np.array([p[0] for p in fprops])
+        self.face_centroid = np.array([p[1] for p in fprops]).reshape(-1, 3)
+        self.surfaces = surfaces
+        self.face_surface = self._face_surfaces(builder, box_solid)
+
+    def _face_zones(self) -> np.ndarray:
+        out = np.full((len(self.faces), 2), -1, np.int32)
+        for i in range(len(self.faces)):
+            owners = sorted({self.zone_index.FindIndex(s) - 1 for s in shapes_of(self.face_map.FindFromIndex(i + 1))})
+            out[i, : len(owners[:2])] = owners[:2]
+        return out
+
+    def _face_surfaces(self, builder: BOPAlgo_Builder | _Unsplit, box_solid: TopoDS_Shape) -> np.ndarray:
+        out = np.full(len(self.faces), -1, np.int32)
+        for s_idx, s in enumerate(self.surfaces):
+            for sheet in s.sheets:
+                for piece in _images(builder, sheet):
+                    k = self.face_map.FindIndex(piece)
+                    if k > 0:
+                        out[k - 1] = s_idx
+        for face in sub_shapes(box_solid, TopAbs_FACE):
+            s_idx = self._match_plane(BRepAdaptor_Surface(TopoDS.Face(face)))
+            for piece in _images(builder, face):
+                k = self.face_map.FindIndex(piece)
+                if k > 0:
+                    out[k - 1] = s_idx
+        for k in np.flatnonzero(out < 0):  # history can miss faces merged by the fuzzy fuse
+            out[k] = self._match_geometry(self.faces[k])
+        return out
+
+    def _match_plane(self, adaptor: BRepAdaptor_Surface) -> int:
+        ax = adaptor.Plane().Position()
+        n = canonical(xyz(ax.Direction()))
+        offset = float(n @ xyz(ax.Location()))
+        for s_idx, s in enumerate(self.surfaces):
+            if s.is_plane and parallel(s.normal, n) and abs(s.offset - offset) < 1e-6:
+                return s_idx
+        return -1
+
+    def _match_geometry(self, face) -> int:
+        adaptor = BRepAdaptor_Surface(face)
+        if adaptor.GetType() == GeomAbs_Plane:
+            return self._match_plane(adaptor)
+        if adaptor.GetType() == GeomAbs_Cylinder:
+            cyl = adaptor.Cylinder()
+            d = canonical(xyz(cyl.Axis().Direction()))
+            for s_idx, s in enumerate(self.surfaces):
+                if s.kind is SurfaceKind.CYLINDER and parallel(s.axis_dir, d) and abs(s.radius - cyl.Radius()) < 1e-6:
+                    return s_idx
+        return -1
+
+    def face_normals(self, interior: np.ndarray) -> np.ndarray:
+        """Unit normals of planar faces, pointing from the face's first zone to its second."""
+        out = np.full((len(self.faces), 3), np.nan)
+        for k, s_idx in enumerate(self.face_surface):
+            if s_idx < 0 or not self.surfaces[s_idx].is_plane:
+                continue
+            s = self.surfaces[s_idx]
+            a = self.face_zones[k, 0]
+            out[k] = s.normal if float(interior[a] @ s.normal) < s.offset else -s.normal
+        return out
+
+    def face_links(self) -> np.ndarray:
+        """Pairs of partition faces that share an edge and lie on the same surface."""
+        edge_faces = ancestors(self.compound, TopAbs_EDGE, TopAbs_FACE)
+        pairs = set()
+        for i in range(1, edge_faces.Size() + 1):
+            ids = sorted({self.face_map.FindIndex(f) - 1 for f in shapes_of(edge_faces.FindFromIndex(i))})
+            for x, a in enumerate(ids):
+                for b in ids[x + 1:]:
+                    if self.face_surface[a] >= 0 and self.face_surface[a] == self.face_surface[b]:
+                        pairs.add((a, b))
+        return np.array(sorted(pairs), np.int32).reshape(-1, 2)
+
+
+def _images(builder: BOPAlgo_Builder | _Unsplit, shape: TopoDS_Shape) -> list[TopoDS_Shape]:
+    if builder.IsDeleted(shape):
+        return []
+    modified = shapes_of(builder.Modified(shape))
+    return modified or [shape]
+
+
+# ---------------------------------------------------------------------- mesh, points, samples
+
+
+class _ZoneMesh:
+    """A triangulation of every partition face, shared by interior points, samples and sides."""
+
+    def __init__(self, topo: _Topology):
+        self.topo = topo
+        BRepMesh_IncrementalMesh(topo.compound, MESH_DEFLECTION, False, 0.5, False)
+        self.face_mesh = [face_triangles(f) for f in topo.faces]
+        self.zone_tris = [self._zone_triangles(z) for z in topo.zones]
+
+    def _zone_triangles(self, zone) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Triangle corners (T, 3, 3), outward unit normals (T, 3) and areas (T,) of a zone."""
+        corners, normals = [], []
+        for face in sub_shapes(zone, TopAbs_FACE):
+            if face.Orientation() == TopAbs_INTERNAL:
+                continue
+            nodes, tris = self.face_mesh[self.topo.face_map.FindIndex(face) - 1]
+            if not len(tris):
+                continue
+            c = nodes[tris]
+            n = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+            normals.append(-n if face.Orientation() == TopAbs_REVERSED else n)
+            corners.append(c)
+        if not corners:
+            return np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(0)
+        c, n = np.concatenate(corners), np.concatenate(normals)
+        length = np.linalg.norm(n, axis=1)
+        keep = length > 0
+        return c[keep], n[keep] / length[keep, None], 0.5 * length[keep]
+
+    def zone_bbox(self) -> np.ndarray:
+        out = np.zeros((len(self.zone_tris), 6))
+        for z, (c, _, _) in enumerate(self.zone_tris):
+            pts = c.reshape(-1, 3)
+            out[z] = np.concatenate([pts.min(0), pts.max(0)]) if len(pts) else np.nan
+        return out
+
+    def interior_points(self, tries: int = 12) -> np.ndarray:
+        """One point per zone, confirmed inside it: the centroid when the zone holds it (convex
+        zones), else a point stepped inward from one of its largest triangles."""
+        out = np.full((len(self.zone_tris), 3), np.nan)
+        for z, (c, n, area) in enumerate(self.zone_tris):
+            if not len(area):
+                continue
+            classifier = BRepClass3d_SolidClassifier(self.topo.zones[z])
+            pts = c.reshape(-1, 3)
+            size = float(np.linalg.norm(pts.max(0) - pts.min(0)))
+            for p in self._candidates(self.topo.zone_centroid[z], c, n, area, size, tries):
+                classifier.Perform(pnt(p), CLASSIFY_TOL)
+                if classifier.State() == TopAbs_IN:
+                    out[z] = p
+                    break
+        return out
+
+    @staticmethod
+    def _candidates(centroid, c, n, area, size, tries):
+        yield centroid
+        for t in np.argsort(-area)[:tries]:
+            centre = c[t].mean(axis=0)
+            for step in (1e-2, 1e-3, 1e-4, 1e-5):
+                yield centre - step * size * n[t]
+
+    def samples(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        points = np.zeros((len(self.zone_tris), count, 3), np.float32)
+        normals = np.zeros_like(points)
+        for z, (c, n, area) in enumerate(self.zone_tris):
+            if not len(area) or count == 0:
+                continue
+            t = rng.choice(len(area), size=count, p=area / area.sum())
+            r1, r2 = np.sqrt(rng.random(count)), rng.random(count)
+            w = np.stack([1 - r1, r1 * (1 - r2), r1 * r2], axis=1)
+            points[z] = np.einsum("pk,pkd->pd", w, c[t])
+            normals[z] = n[t]
+        return points, normals
+
+    def plane_sides(self, surfaces: list[ExtendedSurface]) -> np.ndarray:
+        """(S, Z): which side of each plane every zone lies on (from all its mesh nodes)."""
+        sides = np.zeros((len(surfaces), len(self.zone_tris)), np.int8)
+        plane_ids = [i for i, s in enumerate(surfaces) if s.is_plane]
+        if not plane_ids:
+            return sides
+        normals = np.array([surfaces[i].normal for i in plane_ids])
+        offsets = np.array([surfaces[i].offset for i in plane_ids])
+        for z, (c, _, _) in enumerate(self.zone_tris):
+            if not len(c):
+                continue  # an unmeshable zone: it has no interior point either, and fails the checks
+            d = c.reshape(-1, 3) @ normals.T - offsets
+            lo, hi = d.min(axis=0), d.max(axis=0)
+            sides[plane_ids, z] = np.where(lo > -SIDE_TOL, 1, np.where(hi < SIDE_TOL, -1, 0))
+        return sides
+
+
+def _classify(points: np.ndarray, solids: Sequence[TopoDS_Shape]) -> np.ndarray:
+    classifiers = [BRepClass3d_SolidClassifier(s) for s in solids]
+    inside = np.zeros(len(points), bool)
+    for z, p in enumerate(points):
+        if not np.isfinite(p).all():
+            continue
+        for clf in classifiers:
+            clf.Perform(pnt(p), CLASSIFY_TOL)
+            if clf.State() == TopAbs_IN:
+                inside[z] = True
+                break
+    return inside
+
+
+def _surface_arrays(surfaces: list[ExtendedSurface]) -> dict[str, np.ndarray]:
+    nan3 = np.full(3, np.nan)
+    return {
+        "surface_kind": np.array([s.kind.value for s in surfaces], dtype=object),
+        "surface_normal": np.array([s.normal if s.normal is not None else nan3 for s in surfaces]).reshape(-1, 3),
+        "surface_offset": np.array([s.offset for s in surfaces], float),
+        "surface_axis": np.array([np.concatenate([s.axis_point if s.axis_point is not None else nan3,
+                                                  s.axis_dir if s.axis_dir is not None else nan3])
+                                  for s in surfaces]).reshape(-1, 6),
+        "surface_radius": np.array([s.radius for s in surfaces], float),
+        "surface_on_box": np.array([s.on_box for s in surfaces], bool),
+        "surface_strip": np.array([bool(s.strips) for s in surfaces], bool),
+    }

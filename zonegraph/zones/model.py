@@ -1,0 +1,127 @@
+"""The zone graph (paper sec. 3): zones partitioning the target's bounding box, and their contacts.
+
+Everything is stored as flat numpy arrays in the normalised frame (see ``normalize.py``) so the
+search can work on indices and bit vectors; the zone solids themselves are kept alongside for
+export and rendering. Faces are the partition faces of the general fuse: a face between two zones
+is a graph edge, a face on the box boundary has ``-1`` as its second zone.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from zonegraph.errors import ZoneGraphError
+from zonegraph.geometry.normalize import Normalization
+
+BOX_VOLUME_RTOL = 1e-6
+TARGET_VOLUME_RTOL = 1e-4
+
+
+class BuildStatus(str, enum.Enum):
+    OK = "ok"
+    INVALID_INPUT = "invalid_input"
+    NOT_A_SOLID = "not_a_solid"
+    FUSE_FAILED = "fuse_failed"
+    TARGET_MISMATCH = "target_mismatch"
+    NO_INTERIOR_POINT = "no_interior_point"
+    DISCONNECTED = "disconnected"
+    TIMEOUT = "timeout"
+
+
+class ZoneGraphBuildError(ZoneGraphError):
+    """A zone graph could not be built or broke an invariant; ``status`` says which."""
+
+    def __init__(self, status: BuildStatus, source: str, reason: str):
+        super().__init__(source, reason)
+        self.status = status.value
+
+
+@dataclass
+class ZoneGraph:
+    normalization: Normalization
+    box: np.ndarray  # (6,) normalised AABB of the target
+    target_volume: float  # normalised units
+    # zones (Z)
+    zone_volume: np.ndarray
+    zone_centroid: np.ndarray  # (Z, 3); may lie outside a non-convex zone
+    zone_bbox: np.ndarray  # (Z, 6)
+    zone_interior: np.ndarray  # (Z, 3) verified interior points
+    zone_inside: np.ndarray  # (Z,) bool: inside the target
+    zone_points: np.ndarray  # (Z, P, 3) float32 surface samples
+    zone_normals: np.ndarray  # (Z, P, 3) float32 outward normals
+    # partition faces (F)
+    face_zones: np.ndarray  # (F, 2) int32; second is -1 on the box boundary
+    face_area: np.ndarray
+    face_centroid: np.ndarray  # (F, 3)
+    face_normal: np.ndarray  # (F, 3) from zone 0 towards zone 1 (planar faces; NaN otherwise)
+    face_surface: np.ndarray  # (F,) int32 index into the surfaces (-1: unknown)
+    face_links: np.ndarray  # (L, 2) int32: faces sharing an edge on the same surface
+    # extended surfaces (S)
+    surface_kind: np.ndarray  # (S,) str: plane, cylinder, extrusion, sphere, face
+    surface_normal: np.ndarray  # (S, 3) planes
+    surface_offset: np.ndarray  # (S,) planes: n . x = offset
+    surface_axis: np.ndarray  # (S, 6) cylinders/spheres: point, direction
+    surface_radius: np.ndarray  # (S,)
+    surface_on_box: np.ndarray  # (S,) bool
+    surface_strip: np.ndarray  # (S,) bool: plane extended as face-loop strips only
+    plane_side: np.ndarray  # (S, Z) int8: +1/-1 side of each plane, 0 straddles (or not a plane)
+    solids: list | None = None  # zone solids (TopoDS_Solid), in zone order
+    info: dict = field(default_factory=dict)  # status, simplified, target faces, timings
+
+    @property
+    def n_zones(self) -> int:
+        return len(self.zone_volume)
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.face_area)
+
+    @property
+    def n_surfaces(self) -> int:
+        return len(self.surface_kind)
+
+    @property
+    def edges(self) -> np.ndarray:
+        """Distinct zone pairs sharing at least one face, (E, 2) with the smaller index first."""
+        inner = self.face_zones[self.face_zones[:, 1] >= 0]
+        return np.unique(np.sort(inner, axis=1), axis=0) if len(inner) else np.zeros((0, 2), np.int32)
+
+    @property
+    def box_volume(self) -> float:
+        return float(np.prod(self.box[3:] - self.box[:3]))
+
+    @property
+    def inside_volume(self) -> float:
+        return float(self.zone_volume[self.zone_inside].sum())
+
+    @property
+    def planes(self) -> np.ndarray:
+        return np.flatnonzero(self.surface_kind == "plane")
+
+    def check(self, source: str = "target") -> None:
+        """Raise ZoneGraphBuildError unless every invariant of a usable zone graph holds."""
+        total = float(self.zone_volume.sum())
+        if abs(total - self.box_volume) > BOX_VOLUME_RTOL * self.box_volume:
+            raise ZoneGraphBuildError(BuildStatus.FUSE_FAILED, source,
+                                      f"zone volumes sum to {total / self.box_volume:.9f} of the box")
+        if abs(self.inside_volume - self.target_volume) > TARGET_VOLUME_RTOL * self.target_volume:
+            raise ZoneGraphBuildError(BuildStatus.TARGET_MISMATCH, source,
+                                      f"inside zones hold {self.inside_volume / self.target_volume:.6f} of the target volume")
+        if not np.isfinite(self.zone_interior).all():
+            missing = int((~np.isfinite(self.zone_interior).all(axis=1)).sum())
+            raise ZoneGraphBuildError(BuildStatus.NO_INTERIOR_POINT, source, f"{missing} zones have no interior point")
+        if self.n_zones > 1:
+            e = self.edges
+            adj = coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(self.n_zones,) * 2)
+            n, _ = connected_components(adj, directed=False)
+            if n != 1:
+                raise ZoneGraphBuildError(BuildStatus.DISCONNECTED, source, f"zone graph has {n} components")
+
+    def summary(self) -> dict:
+        return {"zones": self.n_zones, "faces": self.n_faces, "edges": len(self.edges),
+                "surfaces": self.n_surfaces, "inside_zones": int(self.zone_inside.sum()), **self.info}

@@ -1,0 +1,112 @@
+"""Zone graphs on disk: Parquet tables plus one BREP file with the zone solids.
+
+``zones.parquet`` (per zone; the graph's metadata rides in its schema), ``faces.parquet``
+(partition faces: the zones on each side, area, normal, surface), ``links.parquet`` (faces sharing
+an edge on one surface), ``surfaces.parquet`` (extended surfaces and each plane's zone sides),
+``samples.parquet`` (surface samples, float16: they are network inputs, not geometry) and
+``zones.brep`` (the zone solids in zone order, sharing their faces).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+from OCP.BRep import BRep_Builder
+from OCP.BRepTools import BRepTools
+from OCP.TopAbs import TopAbs_SOLID
+from OCP.TopoDS import TopoDS, TopoDS_Shape
+
+from zonegraph.errors import InputError
+from zonegraph.geometry.normalize import Normalization
+from zonegraph.geometry.occ import make_compound, sub_shapes
+from zonegraph.zones.model import ZoneGraph
+
+META_KEY = b"zonegraph"
+
+
+def _fixed(arr: np.ndarray, dtype=None) -> pa.FixedSizeListArray:
+    arr = np.asarray(arr, dtype=dtype)
+    width = int(np.prod(arr.shape[1:])) if arr.ndim > 1 else 1
+    return pa.FixedSizeListArray.from_arrays(pa.array(arr.reshape(-1)), width)
+
+
+def _unfixed(column: pa.ChunkedArray, shape: tuple[int, ...], dtype=float) -> np.ndarray:
+    flat = column.combine_chunks().flatten().to_numpy(zero_copy_only=False)
+    return flat.astype(dtype).reshape((len(column),) + shape)
+
+
+def save_zone_graph(graph: ZoneGraph, folder: str | Path) -> Path:
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    meta = {"center": graph.normalization.center, "scale": graph.normalization.scale,
+            "box": graph.box.tolist(), "target_volume": graph.target_volume, "info": graph.info,
+            "samples": int(graph.zone_points.shape[1])}
+    zones = pa.table({
+        "volume": graph.zone_volume, "centroid": _fixed(graph.zone_centroid), "bbox": _fixed(graph.zone_bbox),
+        "interior": _fixed(graph.zone_interior), "inside": graph.zone_inside,
+    }).replace_schema_metadata({META_KEY: json.dumps(meta)})
+    pq.write_table(zones, folder / "zones.parquet")
+    pq.write_table(pa.table({
+        "zone_a": graph.face_zones[:, 0], "zone_b": graph.face_zones[:, 1], "area": graph.face_area,
+        "centroid": _fixed(graph.face_centroid), "normal": _fixed(graph.face_normal), "surface": graph.face_surface,
+    }), folder / "faces.parquet")
+    pq.write_table(pa.table({"face_a": graph.face_links[:, 0], "face_b": graph.face_links[:, 1]}),
+                   folder / "links.parquet")
+    pq.write_table(pa.table({
+        "kind": pa.array(list(graph.surface_kind), pa.string()), "normal": _fixed(graph.surface_normal),
+        "offset": graph.surface_offset, "axis": _fixed(graph.surface_axis), "radius": graph.surface_radius,
+        "on_box": graph.surface_on_box, "strip": graph.surface_strip,
+        "plane_side": _fixed(graph.plane_side.reshape(graph.n_surfaces, -1), np.int8),
+    }), folder / "surfaces.parquet")
+    pq.write_table(pa.table({"points": _fixed(graph.zone_points, np.float16),
+                             "normals": _fixed(graph.zone_normals, np.float16)}),
+                   folder / "samples.parquet", compression="zstd")
+    if graph.solids is not None:
+        BRepTools.Write_s(make_compound(graph.solids), str(folder / "zones.brep"))
+    return folder
+
+
+def load_zone_graph(folder: str | Path, solids: bool = True) -> ZoneGraph:
+    folder = Path(folder)
+    if not (folder / "zones.parquet").is_file():
+        raise InputError(str(folder), "no zone graph here (zones.parquet missing)")
+    zones = pq.read_table(folder / "zones.parquet")
+    meta = json.loads(zones.schema.metadata[META_KEY])
+    faces = pq.read_table(folder / "faces.parquet")
+    links = pq.read_table(folder / "links.parquet")
+    surfaces = pq.read_table(folder / "surfaces.parquet")
+    samples = pq.read_table(folder / "samples.parquet")
+    n_zones, n_samples = zones.num_rows, meta["samples"]
+    return ZoneGraph(
+        normalization=Normalization(tuple(meta["center"]), meta["scale"]), box=np.array(meta["box"]),
+        target_volume=meta["target_volume"],
+        zone_volume=zones["volume"].to_numpy(), zone_centroid=_unfixed(zones["centroid"], (3,)),
+        zone_bbox=_unfixed(zones["bbox"], (6,)), zone_interior=_unfixed(zones["interior"], (3,)),
+        zone_inside=zones["inside"].to_numpy(zero_copy_only=False),
+        zone_points=_unfixed(samples["points"], (n_samples, 3), np.float32),
+        zone_normals=_unfixed(samples["normals"], (n_samples, 3), np.float32),
+        face_zones=np.stack([faces["zone_a"].to_numpy(), faces["zone_b"].to_numpy()], axis=1).astype(np.int32),
+        face_area=faces["area"].to_numpy(), face_centroid=_unfixed(faces["centroid"], (3,)),
+        face_normal=_unfixed(faces["normal"], (3,)), face_surface=faces["surface"].to_numpy().astype(np.int32),
+        face_links=np.stack([links["face_a"].to_numpy(), links["face_b"].to_numpy()], axis=1).astype(np.int32),
+        surface_kind=np.array(surfaces["kind"].to_pylist(), dtype=object),
+        surface_normal=_unfixed(surfaces["normal"], (3,)), surface_offset=surfaces["offset"].to_numpy(),
+        surface_axis=_unfixed(surfaces["axis"], (6,)), surface_radius=surfaces["radius"].to_numpy(),
+        surface_on_box=surfaces["on_box"].to_numpy(zero_copy_only=False),
+        surface_strip=surfaces["strip"].to_numpy(zero_copy_only=False),
+        plane_side=_unfixed(surfaces["plane_side"], (n_zones,), np.int8),
+        solids=_read_solids(folder / "zones.brep") if solids else None,
+        info=meta["info"],
+    )
+
+
+def _read_solids(path: Path) -> list[TopoDS_Shape] | None:
+    if not path.is_file():
+        return None
+    shape = TopoDS_Shape()
+    BRepTools.Read_s(shape, str(path), BRep_Builder())
+    return [TopoDS.Solid(s) for s in sub_shapes(shape, TopAbs_SOLID)]
