@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from zonegraph.data.design import Design, load_design
-from zonegraph.data.stats import design_statistics, format_comparison
 from zonegraph.data.replay import replay
+from zonegraph.data.stats import design_statistics, format_comparison
 from zonegraph.data.synthetic import synthetic_design
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
@@ -38,10 +38,14 @@ def report(name: str, designs: list[Design]) -> None:
     per_design, per_step, rows = time_replays(designs)
     ms = lambda a, q: 1e3 * float(np.percentile(a, q))  # noqa: E731
     print(f"\n{name}: {len(designs)} designs, {len(per_step)} extrude steps")
-    print(f"  per design  median {ms(per_design, 50):7.1f} ms   p90 {ms(per_design, 90):7.1f} ms   "
-          f"max {1e3 * per_design.max():7.1f} ms   total {per_design.sum():.2f} s")
-    print(f"  per step    median {ms(per_step, 50):7.1f} ms   p90 {ms(per_step, 90):7.1f} ms   "
-          f"max {1e3 * per_step.max():7.1f} ms")
+    print(
+        f"  per design  median {ms(per_design, 50):7.1f} ms   p90 {ms(per_design, 90):7.1f} ms   "
+        f"max {1e3 * per_design.max():7.1f} ms   total {per_design.sum():.2f} s"
+    )
+    print(
+        f"  per step    median {ms(per_step, 50):7.1f} ms   p90 {ms(per_step, 90):7.1f} ms   "
+        f"max {1e3 * per_step.max():7.1f} ms"
+    )
     print("  slowest: " + ", ".join(f"{i} ({n} steps, {1e3 * s:.0f} ms)" for s, i, n in rows[:3]))
 
 

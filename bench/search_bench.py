@@ -14,13 +14,13 @@ from pathlib import Path
 import numpy as np
 
 from zonegraph.data.design import load_design
+from zonegraph.data.replay import replay
+from zonegraph.data.synthetic import synthetic_design
 from zonegraph.errors import ZoneGraphError
+from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
 from zonegraph.zones.build import build_zone_graph
-from zonegraph.sequence.proposals import ProposalGenerator
-from zonegraph.data.replay import replay
-from zonegraph.sequence.best_first import SearchConfig, search
-from zonegraph.data.synthetic import synthetic_design
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 
@@ -37,13 +37,19 @@ def run(name: str, designs, budget: float, guide: str, max_zones: int) -> None:
         result = search(graph, make_ranker(guide), SearchConfig(budget_s=budget), ProposalGenerator(graph))
         props += result.proposals_per_state
         times += result.expansion_s
-        per_design.append((design.id, graph.n_zones, result.exact, result.time_to_best_s, max(result.expansion_s or [0])))
+        per_design.append(
+            (design.id, graph.n_zones, result.exact, result.time_to_best_s, max(result.expansion_s or [0]))
+        )
     p, t = np.array(props), 1e3 * np.array(times)
     exact = sum(d[2] for d in per_design)
-    print(f"\n{name} ({guide}, budget {budget:g} s): {len(per_design)} designs searched, {exact} exact, "
-          f"{len(t)} expansions")
+    print(
+        f"\n{name} ({guide}, budget {budget:g} s): {len(per_design)} designs searched, {exact} exact, "
+        f"{len(t)} expansions"
+    )
     print(f"  proposals per state  median {np.median(p):.0f}  p90 {np.percentile(p, 90):.0f}  max {p.max()}")
-    print(f"  ms per expansion     median {np.median(t):.2f}  p90 {np.percentile(t, 90):.2f}  max {t.max():.1f}")
+    print(
+        f"  ms per expansion     median {np.median(t):.2f}  p90 {np.percentile(t, 90):.2f}  max {t.max():.1f}"
+    )
     tt = np.array([d[3] for d in per_design if d[2]])
     if len(tt):
         print(f"  time to exact s      median {np.median(tt):.3f}  max {tt.max():.3f}")
@@ -58,11 +64,18 @@ def main() -> None:
     parser.add_argument("--synthetic", type=int, default=100)
     parser.add_argument("--budget", type=float, default=5.0)
     parser.add_argument("--guide", default="heuristic")
-    parser.add_argument("--max-zones", type=int, default=2000, help="skip larger graphs (their build dominates)")
+    parser.add_argument(
+        "--max-zones", type=int, default=2000, help="skip larger graphs (their build dominates)"
+    )
     args = parser.parse_args()
     if SAMPLES.is_dir():
-        run("real samples", [load_design(p) for p in sorted(SAMPLES.glob("*.json"))], args.budget, args.guide,
-            args.max_zones)
+        run(
+            "real samples",
+            [load_design(p) for p in sorted(SAMPLES.glob("*.json"))],
+            args.budget,
+            args.guide,
+            args.max_zones,
+        )
     synthetic = (synthetic_design(i) for i in range(args.synthetic))
     run("synthetic", synthetic, args.budget, args.guide, args.max_zones)
 

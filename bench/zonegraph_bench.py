@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from zonegraph.data.design import load_design
-from zonegraph.isolation import Outcome, run_isolated
-from zonegraph.zones.build import build_zone_graph
 from zonegraph.data.replay import replay
 from zonegraph.data.synthetic import synthetic_design
+from zonegraph.isolation import Outcome, run_isolated
+from zonegraph.zones.build import build_zone_graph
 
 SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 
@@ -30,7 +30,9 @@ def _build(source: str, simplify: bool) -> dict:
         design = synthetic_design(i)
     else:
         design = load_design(source)
-    return build_zone_graph(list(replay(design).bodies), simplify=simplify, samples=512, source=source).summary()
+    return build_zone_graph(
+        list(replay(design).bodies), simplify=simplify, samples=512, source=source
+    ).summary()
 
 
 def _job(args: tuple[str, bool, float]) -> tuple[str, bool, Outcome]:
@@ -50,11 +52,20 @@ def report(name: str, results: list[tuple[str, bool, Outcome]]) -> None:
         zones = np.array([v["zones"] for _, v in ok])
         faces = np.array([v["target_faces"] for _, v in ok])
         print(f"\n{label}: {len(ok)}/{len(rows)} ok")
-        print(f"  build s   median {np.median(build):.3f}  p90 {np.percentile(build, 90):.3f}  max {build.max():.2f}")
-        print(f"  zones     median {np.median(zones):.0f}  p90 {np.percentile(zones, 90):.0f}  max {zones.max()}")
+        print(
+            f"  build s   median {np.median(build):.3f}  p90 {np.percentile(build, 90):.3f}  "
+            f"max {build.max():.2f}"
+        )
+        print(
+            f"  zones     median {np.median(zones):.0f}  p90 {np.percentile(zones, 90):.0f}  "
+            f"max {zones.max()}"
+        )
         print(f"  faces     median {np.median(faces):.0f}  max {faces.max()}")
         slow = sorted(ok, key=lambda r: -r[1]["build_s"])[:3]
-        print("  slowest: " + ", ".join(f"{Path(s).stem} ({v['zones']} zones, {v['build_s']:.2f} s)" for s, v in slow))
+        print(
+            "  slowest: "
+            + ", ".join(f"{Path(s).stem} ({v['zones']} zones, {v['build_s']:.2f} s)" for s, v in slow)
+        )
         for s, o in rows:
             if not o.ok:
                 print(f"  FAILED {Path(s).stem}: {o.status}: {o.reason}")

@@ -1,6 +1,6 @@
 """Zone graph statistics (paper fig. 4): zone count vs face count, build time vs zone count.
 
-    python -m eval.zone_stats [MANIFEST] [--out DIR]
+python -m eval.zone_stats [MANIFEST] [--out DIR]
 """
 
 from __future__ import annotations
@@ -24,8 +24,13 @@ def plot_zone_stats(manifest: pd.DataFrame, out: Path) -> dict:
     axes[0].scatter(ok["faces_in"], ok["zones"], s=8, alpha=0.6)
     axes[0].set(xlabel="B-rep face count", ylabel="zone count", yscale="log", title="Zones vs faces")
     axes[1].scatter(ok["zones"], ok["build_s"], s=8, alpha=0.6, color="tab:orange")
-    axes[1].set(xlabel="zone count", ylabel="build time (s)", xscale="log", yscale="log",
-                title="Zone graph build time vs zones")
+    axes[1].set(
+        xlabel="zone count",
+        ylabel="build time (s)",
+        xscale="log",
+        yscale="log",
+        title="Zone graph build time vs zones",
+    )
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle(f"{len(ok)} zone graphs ({'simplified' if ok['simplified'].all() else 'not simplified'})")
@@ -33,8 +38,11 @@ def plot_zone_stats(manifest: pd.DataFrame, out: Path) -> dict:
     fig.savefig(out / "zone_stats.png", dpi=120)
     plt.close(fig)
     stats = {
-        "designs": int(len(manifest)), "ok": int(len(ok)),
-        "zones": _describe(ok["zones"]), "faces_in": _describe(ok["faces_in"]), "build_s": _describe(ok["build_s"]),
+        "designs": int(len(manifest)),
+        "ok": int(len(ok)),
+        "zones": _describe(ok["zones"]),
+        "faces_in": _describe(ok["faces_in"]),
+        "build_s": _describe(ok["build_s"]),
         "slowest": ok.nlargest(5, "build_s")[["design_id", "zones", "build_s"]].to_dict("records"),
     }
     (out / "zone_stats.json").write_text(json.dumps(stats, indent=2))
@@ -45,8 +53,12 @@ def _describe(values: pd.Series) -> dict:
     v = values.to_numpy(float)
     if not len(v):
         return {}
-    return {"median": float(np.median(v)), "p90": float(np.percentile(v, 90)), "max": float(v.max()),
-            "mean": float(v.mean())}
+    return {
+        "median": float(np.median(v)),
+        "p90": float(np.percentile(v, 90)),
+        "max": float(v.max()),
+        "mean": float(v.mean()),
+    }
 
 
 def main() -> None:
@@ -55,7 +67,9 @@ def main() -> None:
     parser.add_argument("--out", default="data/plots/zonegraphs")
     args = parser.parse_args()
     stats = plot_zone_stats(pd.read_parquet(args.manifest), Path(args.out))
-    print(f"zone stats: {stats['ok']} graphs, zones {stats['zones']}, build_s {stats['build_s']} -> {args.out}")
+    print(
+        f"zone stats: {stats['ok']} graphs, zones {stats['zones']}, build_s {stats['build_s']} -> {args.out}"
+    )
 
 
 if __name__ == "__main__":

@@ -9,8 +9,8 @@ this package installed, and the data folder on a shared file system.
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Iterator
 
 import dask
 from distributed import Client, LocalCluster
@@ -24,8 +24,14 @@ def dask_client(cfg: dict) -> Iterator[Client]:
             yield client
         return
     with dask.config.set({"distributed.worker.daemon": False}):
-        with LocalCluster(
-            n_workers=int(cfg.get("n_workers", 2)), threads_per_worker=1, processes=True,
-            dashboard_address=None, silence_logs=logging.ERROR,
-        ) as cluster, Client(cluster) as client:
+        with (
+            LocalCluster(
+                n_workers=int(cfg.get("n_workers", 2)),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=logging.ERROR,
+            ) as cluster,
+            Client(cluster) as client,
+        ):
             yield client

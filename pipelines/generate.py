@@ -59,8 +59,9 @@ def main() -> None:
         folder = generate(int(syn["count"]), int(syn["seed"]), params["dask"], float(syn["timeout_s"]))
     records = read_dataset(folder, seed=int(data["split_seed"]), test_fraction=float(data["test_fraction"]))
     OUT.mkdir(parents=True, exist_ok=True)
-    pd.DataFrame([{"design_id": r.design_id, "path": str(r.path), "split": r.split} for r in records]
-                 ).to_parquet(OUT / "index.parquet", index=False)
+    pd.DataFrame(
+        [{"design_id": r.design_id, "path": str(r.path), "split": r.split} for r in records]
+    ).to_parquet(OUT / "index.parquet", index=False)
     designs = []
     for r in records:
         try:

@@ -2,8 +2,9 @@
 
 Every test design whose replay succeeded is reconstructed from its final B-rep with each guide at
 the same budget (``params.yaml: reconstruct``), starting from the zone graph the ``zonegraphs``
-stage saved (zone-graph build time is excluded from the budget, as in the paper). Results: ``data/reconstruct/results.parquet`` (one
-row per design and guide), each program under ``data/reconstruct/<guide>/<id>/`` and the metrics
+stage saved (zone-graph build time is excluded from the budget, as in the paper). Results:
+``data/reconstruct/results.parquet`` (one row per design and guide), each program under
+``data/reconstruct/<guide>/<id>/`` and the metrics
 (exact rate, mean B-rep IoU, median time to exact, per guide) in ``data/metrics/reconstruct.json``.
 """
 
@@ -15,7 +16,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from zonegraph.reconstruction import InferConfig, infer
+from zonegraph.configs import InferConfig
+from zonegraph.reconstruction import infer
 
 from .cluster import dask_client
 from .params import load_params
@@ -27,7 +29,7 @@ METRICS = Path("data/metrics/reconstruct.json")
 
 def reconstruct_design(target: str, out: str, config: InferConfig, saved_graph: str) -> dict:
     """Job body: infer without rendering, reusing the zonegraphs stage's graph; plain data."""
-    result = infer(target, out, config, render=False, saved_graph=saved_graph)
+    result = infer(target, out, config, render=False, saved_graph=saved_graph).to_dict()
     result.pop("config")
     result["operations"] = ",".join(result["operations"])
     return result
@@ -39,11 +41,14 @@ def summarise(results: pd.DataFrame) -> dict:
         ok = rows[rows["status"].isin(["exact", "partial", "rebuild_failed"])]
         exact = ok[ok["exact"].astype(bool)]
         metrics[guide] = {
-            "designs": int(len(rows)), "searched": int(len(ok)),
+            "designs": int(len(rows)),
+            "searched": int(len(ok)),
             "exact_rate": float(len(exact) / len(rows)) if len(rows) else 0.0,
             "mean_iou_brep": float(ok["iou_brep"].fillna(0).sum() / len(rows)) if len(rows) else 0.0,
             "median_time_to_exact_s": float(np.median(exact["time_to_best_s"])) if len(exact) else None,
-            "failures": {k: int(v) for k, v in rows.loc[~rows.index.isin(ok.index), "status"].value_counts().items()},
+            "failures": {
+                k: int(v) for k, v in rows.loc[~rows.index.isin(ok.index), "status"].value_counts().items()
+            },
         }
     return metrics
 
@@ -57,17 +62,22 @@ def main() -> None:
     code = code_fingerprint("reconstruct")
     jobs = []
     for guide in cfg["guides"]:
-        config = InferConfig(guide, float(cfg["budget_s"]), int(cfg["k"]), float(cfg["k_decay"]),
-                             int(cfg["max_depth"]), int(cfg["seed"]), int(cfg["level"]))
+        config = InferConfig.from_mapping({**cfg, "guide": guide})
         for row in test.itertuples():
             brep = f"{row.brep_dir}/final.brep"
             graph = Path("data/zonegraphs/graphs") / row.design_id
-            jobs.append(Job(f"{guide}__{row.design_id}", fingerprint(code, repr(config), files=(brep, graph)),
-                            (brep, str(OUT / guide / row.design_id), config, str(graph)),
-                            cost=float(zones.get(row.design_id, 0))))
+            jobs.append(
+                Job(
+                    f"{guide}__{row.design_id}",
+                    fingerprint(code, repr(config), files=(brep, graph)),
+                    (brep, str(OUT / guide / row.design_id), config, str(graph)),
+                    cost=float(zones.get(row.design_id, 0)),
+                )
+            )
     with dask_client(params["dask"]) as client:
-        records = run_jobs(reconstruct_design, jobs, OUT / "records", client,
-                           float(cfg["timeout_s"]), "reconstruct")
+        records = run_jobs(
+            reconstruct_design, jobs, OUT / "records", client, float(cfg["timeout_s"]), "reconstruct"
+        )
     results = pd.DataFrame(records).drop(columns=["fingerprint"])
     results[["guide", "design_id"]] = results["design_id"].str.split("__", n=1, expand=True)
     results.to_parquet(OUT / "results.parquet", index=False)
@@ -75,8 +85,11 @@ def main() -> None:
     METRICS.parent.mkdir(parents=True, exist_ok=True)
     METRICS.write_text(json.dumps(metrics, indent=2))
     for guide, m in metrics.items():
-        print(f"reconstruct [{guide}]: exact {m['exact_rate']:.1%} of {m['designs']}, mean B-rep IoU "
-              f"{m['mean_iou_brep']:.4f}, median time to exact {m['median_time_to_exact_s']} s, failures {m['failures']}")
+        print(
+            f"reconstruct [{guide}]: exact {m['exact_rate']:.1%} of {m['designs']}, mean B-rep IoU "
+            f"{m['mean_iou_brep']:.4f}, median time to exact {m['median_time_to_exact_s']} s, "
+            f"failures {m['failures']}"
+        )
 
 
 if __name__ == "__main__":

@@ -38,9 +38,14 @@ def replay_design(path: str, out_dir: str) -> dict:
         "steps": len(result.steps),
         "operations": ",".join(st["operation"] for st in s["steps"]),
         "extents": ",".join(st["extent_type"] for st in s["steps"]),
-        "volume": s["volume"], "area": s["area"], "faces": s["face_count"], "bodies": s["body_count"],
-        "volume_rel_error": check.get("volume_rel_error"), "area_rel_error": check.get("area_rel_error"),
-        "replay_seconds": s["seconds"], "brep_dir": str(out),
+        "volume": s["volume"],
+        "area": s["area"],
+        "faces": s["face_count"],
+        "bodies": s["body_count"],
+        "volume_rel_error": check.get("volume_rel_error"),
+        "area_rel_error": check.get("area_rel_error"),
+        "replay_seconds": s["seconds"],
+        "brep_dir": str(out),
     }
 
 
@@ -49,20 +54,25 @@ def main() -> None:
     index = pd.read_parquet("data/designs/index.parquet")
     code = code_fingerprint("replay")
     jobs = [
-        Job(row.design_id, fingerprint(code, files=(row.path,)),
-            (row.path, str(OUT / "breps" / row.design_id)))
+        Job(
+            row.design_id,
+            fingerprint(code, files=(row.path,)),
+            (row.path, str(OUT / "breps" / row.design_id)),
+        )
         for row in index.itertuples()
     ]
     with dask_client(params["dask"]) as client:
-        records = run_jobs(replay_design, jobs, OUT / "records", client,
-                           float(params["replay"]["timeout_s"]), "replay")
+        records = run_jobs(
+            replay_design, jobs, OUT / "records", client, float(params["replay"]["timeout_s"]), "replay"
+        )
     manifest = pd.DataFrame(records).drop(columns=["fingerprint"])
     manifest.insert(1, "split", index["split"].to_numpy())
     manifest = manifest.rename(columns={"reason": "error"})
     manifest.to_parquet(OUT / "manifest.parquet", index=False)
     ok = manifest["status"] == "ok"
     metrics = {
-        "designs": int(len(manifest)), "ok": int(ok.sum()),
+        "designs": int(len(manifest)),
+        "ok": int(ok.sum()),
         "failed": {k: int(v) for k, v in manifest.loc[~ok, "status"].value_counts().items()},
         "median_seconds": float(np.median(manifest["seconds"])) if len(manifest) else 0.0,
         "max_volume_rel_error": float(manifest.loc[ok, "volume_rel_error"].max()) if ok.any() else None,

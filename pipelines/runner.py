@@ -11,9 +11,10 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import yaml
 from distributed import Client, as_completed
@@ -38,8 +39,11 @@ def _tree_files(path: Path) -> list[Path]:
     """A file, or every file under a folder in a stable order (caches and bytecode left out)."""
     if path.is_file():
         return [path]
-    return sorted(f for f in path.rglob("*") if f.is_file() and "__pycache__" not in f.parts
-                  and f.suffix not in {".pyc", ".tmp"})
+    return sorted(
+        f
+        for f in path.rglob("*")
+        if f.is_file() and "__pycache__" not in f.parts and f.suffix not in {".pyc", ".tmp"}
+    )
 
 
 def fingerprint(*parts: Any, files: tuple[str | Path, ...] = ()) -> str:
@@ -72,8 +76,13 @@ def code_fingerprint(stage: str, root: str | Path = PROJECT) -> str:
 
 def _execute(fn: Callable, job: Job, timeout: float | None) -> dict:
     outcome = run_isolated(fn, job.args, timeout)
-    record = {"design_id": job.key, "fingerprint": job.fingerprint, "status": outcome.status,
-              "reason": outcome.reason, "seconds": round(outcome.seconds, 4)}
+    record = {
+        "design_id": job.key,
+        "fingerprint": job.fingerprint,
+        "status": outcome.status,
+        "reason": outcome.reason,
+        "seconds": round(outcome.seconds, 4),
+    }
     if outcome.ok and outcome.value:
         record.update(outcome.value)
     return record
@@ -92,8 +101,9 @@ def _load(path: Path) -> dict | None:
         return None
 
 
-def run_jobs(fn: Callable, jobs: list[Job], records_dir: Path, client: Client,
-             timeout: float | None, desc: str) -> list[dict]:
+def run_jobs(
+    fn: Callable, jobs: list[Job], records_dir: Path, client: Client, timeout: float | None, desc: str
+) -> list[dict]:
     """Records for all ``jobs`` (in order), computing only those not already done."""
     records_dir.mkdir(parents=True, exist_ok=True)
     done: dict[str, dict] = {}
@@ -108,15 +118,20 @@ def run_jobs(fn: Callable, jobs: list[Job], records_dir: Path, client: Client,
     if done:
         print(f"{desc}: {len(done)} of {len(jobs)} designs already done, resuming", flush=True)
     futures = client.map(_execute, [fn] * len(todo), todo, [timeout] * len(todo), pure=False)
-    key_of = {f.key: job for f, job in zip(futures, todo)}
+    key_of = {f.key: job for f, job in zip(futures, todo, strict=False)}
     with tqdm(total=len(todo), desc=desc, unit="design", mininterval=2.0) as bar:
         for future in as_completed(futures):
             job = key_of[future.key]
             try:
                 record = future.result()
             except Exception as exc:  # the worker itself died: record it, keep going
-                record = {"design_id": job.key, "fingerprint": job.fingerprint, "status": "crash",
-                          "reason": f"{type(exc).__name__}: {exc}", "seconds": 0.0}
+                record = {
+                    "design_id": job.key,
+                    "fingerprint": job.fingerprint,
+                    "status": "crash",
+                    "reason": f"{type(exc).__name__}: {exc}",
+                    "seconds": 0.0,
+                }
             _write_atomic(records_dir / f"{job.key}.json", record)
             done[job.key] = record
             bar.update()

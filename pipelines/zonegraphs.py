@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from zonegraph.configs import BuildConfig
 from zonegraph.jobs import build_and_save
 
 from .cluster import dask_client
@@ -29,21 +30,30 @@ def main() -> None:
     replayed = pd.read_parquet("data/replay/manifest.parquet")
     ok = replayed[replayed["status"] == "ok"]
     code = code_fingerprint("zonegraphs")
-    settings = (code, bool(cfg["simplify"]), int(cfg["samples"]), int(cfg["seed"]))
+    config = BuildConfig.from_mapping(cfg)
     jobs = [
-        Job(row.design_id, fingerprint(*settings, files=(f"{row.brep_dir}/final.brep",)),
-            (f"{row.brep_dir}/final.brep", str(OUT / "graphs" / row.design_id), *settings[1:]), cost=row.faces)
+        Job(
+            row.design_id,
+            fingerprint(code, repr(config), files=(f"{row.brep_dir}/final.brep",)),
+            (f"{row.brep_dir}/final.brep", str(OUT / "graphs" / row.design_id), config),
+            cost=row.faces,
+        )
         for row in ok.itertuples()
     ]
     with dask_client(params["dask"]) as client:
-        records = run_jobs(build_and_save, jobs, OUT / "records", client, float(cfg["timeout_s"]), "zonegraphs")
+        records = run_jobs(
+            build_and_save, jobs, OUT / "records", client, float(cfg["timeout_s"]), "zonegraphs"
+        )
     built = pd.DataFrame(records).drop(columns=["fingerprint"])
-    skipped = replayed.loc[replayed["status"] != "ok", ["design_id", "status", "error"]].rename(columns={"error": "reason"})
+    skipped = replayed.loc[replayed["status"] != "ok", ["design_id", "status", "error"]].rename(
+        columns={"error": "reason"}
+    )
     manifest = pd.concat([built, skipped], ignore_index=True)
     manifest = manifest.merge(replayed[["design_id", "split"]], on="design_id")
-    manifest = manifest.rename(columns={"target_faces": "faces_in", "faces": "partition_faces",
-                                        "seconds": "job_seconds"})
-    manifest["simplified"] = bool(cfg["simplify"])
+    manifest = manifest.rename(
+        columns={"target_faces": "faces_in", "faces": "partition_faces", "seconds": "job_seconds"}
+    )
+    manifest["simplified"] = config.simplify
     manifest.to_parquet(OUT / "manifest.parquet", index=False)
     write_metrics(manifest)
 
@@ -52,7 +62,8 @@ def write_metrics(manifest: pd.DataFrame) -> None:
     ok = manifest["status"] == "ok"
     build = manifest.loc[ok, "build_s"].to_numpy(float)
     metrics = {
-        "designs": int(len(manifest)), "ok": int(ok.sum()),
+        "designs": int(len(manifest)),
+        "ok": int(ok.sum()),
         "by_status": {k: int(v) for k, v in manifest["status"].value_counts().items()},
         "median_build_s": float(np.median(build)) if len(build) else None,
         "p90_build_s": float(np.percentile(build, 90)) if len(build) else None,
@@ -60,8 +71,10 @@ def write_metrics(manifest: pd.DataFrame) -> None:
     }
     METRICS.parent.mkdir(parents=True, exist_ok=True)
     METRICS.write_text(json.dumps(metrics, indent=2))
-    print(f"zonegraphs: {metrics['ok']}/{metrics['designs']} ok, median build {metrics['median_build_s']} s, "
-          f"by status {metrics['by_status']}")
+    print(
+        f"zonegraphs: {metrics['ok']}/{metrics['designs']} ok, median build {metrics['median_build_s']} s, "
+        f"by status {metrics['by_status']}"
+    )
     for row in manifest.loc[~ok].itertuples():
         print(f"  {row.design_id}: {row.status}: {row.reason}")
 

@@ -24,9 +24,17 @@ def line(a, b):
 def arc(c, r, a0, a1):
     """Counter-clockwise arc about +z from angle a0 to a1 (reference vector +x)."""
     p = lambda t: (c[0] + r * math.cos(t), c[1] + r * math.sin(t))  # noqa: E731
-    return {"type": "Arc3D", "start_point": pt(*p(a0)), "end_point": pt(*p(a1)), "center_point": pt(*c),
-            "radius": r, "normal": vec(0, 0, 1), "start_angle": a0, "end_angle": a1,
-            "reference_vector": vec(1, 0, 0)}
+    return {
+        "type": "Arc3D",
+        "start_point": pt(*p(a0)),
+        "end_point": pt(*p(a1)),
+        "center_point": pt(*c),
+        "radius": r,
+        "normal": vec(0, 0, 1),
+        "start_angle": a0,
+        "end_angle": a1,
+        "reference_vector": vec(1, 0, 0),
+    }
 
 
 def circle(c, r):
@@ -34,13 +42,26 @@ def circle(c, r):
 
 
 def ellipse(c, a, b):
-    return {"type": "Ellipse3D", "center_point": pt(*c), "major_axis": vec(1, 0, 0),
-            "major_axis_radius": a, "minor_axis_radius": b, "normal": vec(0, 0, 1)}
+    return {
+        "type": "Ellipse3D",
+        "center_point": pt(*c),
+        "major_axis": vec(1, 0, 0),
+        "major_axis_radius": a,
+        "minor_axis_radius": b,
+        "normal": vec(0, 0, 1),
+    }
 
 
 def nurbs(points, degree, knots):
-    return {"type": "NurbsCurve3D", "degree": degree, "knots": knots, "rational": False,
-            "control_points": [pt(*p) for p in points], "weights": [], "periodic": False}
+    return {
+        "type": "NurbsCurve3D",
+        "degree": degree,
+        "knots": knots,
+        "rational": False,
+        "control_points": [pt(*p) for p in points],
+        "weights": [],
+        "periodic": False,
+    }
 
 
 def rect(x0, y0, x1, y1):
@@ -50,9 +71,12 @@ def rect(x0, y0, x1, y1):
 
 def sketch(loops, frame=XY, name="Sketch1"):
     """``loops``: a list of (is_outer, curves); one profile named 'p'."""
-    return {"type": "Sketch", "name": name,
-            "transform": {k: (pt(*v) if k == "origin" else vec(*v)) for k, v in frame.items()},
-            "profiles": {"p": {"loops": [{"is_outer": o, "profile_curves": c} for o, c in loops]}}}
+    return {
+        "type": "Sketch",
+        "name": name,
+        "transform": {k: (pt(*v) if k == "origin" else vec(*v)) for k, v in frame.items()},
+        "profiles": {"p": {"loops": [{"is_outer": o, "profile_curves": c} for o, c in loops]}},
+    }
 
 
 def extent(d, taper=0.0, full=None):
@@ -62,12 +86,28 @@ def extent(d, taper=0.0, full=None):
     return out
 
 
-def extrude(sketch_id, op="NewBodyFeatureOperation", kind="OneSideFeatureExtentType", one=None, two=None,
-            offset=None, profile="p"):
-    e = {"type": "ExtrudeFeature", "name": "Extrude", "operation": op, "extent_type": kind,
-         "profiles": [{"profile": profile, "sketch": sketch_id}], "extent_one": one or extent(1.0),
-         "start_extent": ({"type": "ProfilePlaneStartDefinition"} if offset is None else
-                          {"type": "OffsetStartDefinition", "offset": {"value": offset}})}
+def extrude(
+    sketch_id,
+    op="NewBodyFeatureOperation",
+    kind="OneSideFeatureExtentType",
+    one=None,
+    two=None,
+    offset=None,
+    profile="p",
+):
+    e = {
+        "type": "ExtrudeFeature",
+        "name": "Extrude",
+        "operation": op,
+        "extent_type": kind,
+        "profiles": [{"profile": profile, "sketch": sketch_id}],
+        "extent_one": one or extent(1.0),
+        "start_extent": (
+            {"type": "ProfilePlaneStartDefinition"}
+            if offset is None
+            else {"type": "OffsetStartDefinition", "offset": {"value": offset}}
+        ),
+    }
     if two is not None:
         e["extent_two"] = two
     return e

@@ -11,15 +11,20 @@ import pytest
 
 from zonegraph.geometry.shapes import read_solids
 
-
 SCRIPT = Path(sys.executable).parent / "zonegraph"
 
 
-@pytest.mark.skipif(not SCRIPT.exists(), reason=f"console script not installed at {SCRIPT} (pip install -e .)")
+@pytest.mark.skipif(
+    not SCRIPT.exists(), reason=f"console script not installed at {SCRIPT} (pip install -e .)"
+)
 def test_replay_writes_steps_and_summary(samples_dir, tmp_path):
     out = tmp_path / "out"
-    proc = subprocess.run([str(SCRIPT), "replay", str(samples_dir / "Pattern2_6c40bf33_0000.json"), "--out", str(out)],
-                          capture_output=True, text=True, check=True)
+    proc = subprocess.run(
+        [str(SCRIPT), "replay", str(samples_dir / "Pattern2_6c40bf33_0000.json"), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     assert "2 extrudes" in proc.stdout
     summary = json.loads((out / "summary.json").read_text())
     assert [s["operation"] for s in summary["steps"]] == ["new_body", "cut"]

@@ -9,14 +9,14 @@ from pathlib import Path
 
 import pytest
 
-from zonegraph.data.design import load_design
-from zonegraph.reconstruction import InferConfig, infer
-from zonegraph.sequence.program import brep_iou
-from zonegraph.data.replay import as_shape, replay
-from zonegraph.geometry.shapes import read_solids
-from zonegraph.data.targets import load_target
-
 from tests.conftest import requires_samples, sample_paths
+from zonegraph.configs import InferConfig
+from zonegraph.data.design import load_design
+from zonegraph.data.replay import as_shape, replay
+from zonegraph.data.targets import load_target
+from zonegraph.geometry.shapes import read_solids
+from zonegraph.reconstruction import infer
+from zonegraph.sequence.program import brep_iou
 
 DISTINCT = [p for p in sample_paths() if not p.stem.startswith(("SingleSketchExtrude_", "Z0HexagonCutJoin"))]
 SCRIPT = Path(sys.executable).parent / "zonegraph"
@@ -26,15 +26,18 @@ SCRIPT = Path(sys.executable).parent / "zonegraph"
 def inferred(tmp_path_factory):
     """Every distinct sample inferred once (heuristic, 10 s budget)."""
     root = tmp_path_factory.mktemp("infer")
-    return {p.stem: (p, root / p.stem, infer(str(p), str(root / p.stem), InferConfig(budget_s=10))) for p in DISTINCT}
+    return {
+        p.stem: (p, root / p.stem, infer(str(p), str(root / p.stem), InferConfig(budget_s=10)))
+        for p in DISTINCT
+    }
 
 
 @requires_samples
 def test_every_distinct_sample_is_exact_within_10_s(inferred):
     assert len(inferred) == 18
     for name, (_, out, result) in inferred.items():
-        assert result["exact"] and result["iou_brep"] >= 0.9999, name
-        assert result["search_s"] <= 10.0, name
+        assert result.exact and result.iou_brep >= 0.9999, name
+        assert result.search_s <= 10.0, name
         assert json.loads((out / "result.json").read_text())["status"] == "exact"
         assert (out / "sequence.png").stat().st_size > 0 and (out / "steps/00.step").is_file()
 
@@ -48,8 +51,14 @@ def test_exported_scripts_rebuild_the_parts_in_a_fresh_process(inferred, tmp_pat
         "    sys.argv = [script, out]\n"
         "    runpy.run_path(script, run_name='__main__')\n"
     )
-    args = [a for name, (_, out, _) in inferred.items() for a in (str(out / "sequence.py"), str(tmp_path / f"{name}.step"))]
-    subprocess.run([sys.executable, str(runner), *args], check=True, capture_output=True, text=True, timeout=600)
+    args = [
+        a
+        for name, (_, out, _) in inferred.items()
+        for a in (str(out / "sequence.py"), str(tmp_path / f"{name}.step"))
+    ]
+    subprocess.run(
+        [sys.executable, str(runner), *args], check=True, capture_output=True, text=True, timeout=600
+    )
     for name, (path, _, _) in inferred.items():
         target = as_shape(load_target(path))
         rebuilt = as_shape(read_solids(tmp_path / f"{name}.step"))
@@ -67,16 +76,19 @@ def test_exported_json_replays_to_the_same_solid(inferred):
 @requires_samples
 def test_step_input_in_millimetres(samples_dir, tmp_path):
     result = infer(str(samples_dir / "Couch.step"), str(tmp_path / "couch"))
-    assert result["exact"]
+    assert result.exact
     target = read_solids(samples_dir / "Couch.step")[0]
-    rebuilt = as_shape(read_solids(tmp_path / "couch" / "steps" / f"{result['steps'] - 1:02d}.step"))
+    rebuilt = as_shape(read_solids(tmp_path / "couch" / "steps" / f"{result.steps - 1:02d}.step"))
     assert brep_iou(rebuilt, target) >= 0.9999  # same units and position as the input
 
 
 @pytest.mark.skipif(not SCRIPT.exists(), reason=f"console script not installed at {SCRIPT}")
 def test_cli_infer_bad_input_is_one_line(tmp_path):
-    proc = subprocess.run([str(SCRIPT), "infer", str(tmp_path / "absent.step"), "--out", str(tmp_path / "o")],
-                          capture_output=True, text=True)
+    proc = subprocess.run(
+        [str(SCRIPT), "infer", str(tmp_path / "absent.step"), "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0 and "no such file" in proc.stderr
 
@@ -84,10 +96,35 @@ def test_cli_infer_bad_input_is_one_line(tmp_path):
 @pytest.mark.skipif(not SCRIPT.exists(), reason=f"console script not installed at {SCRIPT}")
 def test_cli_infer_writes_result(samples_dir, tmp_path):
     out = tmp_path / "o"
-    proc = subprocess.run([str(SCRIPT), "infer", str(samples_dir / "Pattern2_6c40bf33_0000.json"), "--out", str(out),
-                           "--guide", "random", "--budget", "5", "--seed", "1"], capture_output=True, text=True)
+    proc = subprocess.run(
+        [
+            str(SCRIPT),
+            "infer",
+            str(samples_dir / "Pattern2_6c40bf33_0000.json"),
+            "--out",
+            str(out),
+            "--guide",
+            "random",
+            "--budget",
+            "5",
+            "--seed",
+            "1",
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 0, proc.stderr
     result = json.loads((out / "result.json").read_text())
-    assert set(result) >= {"status", "exact", "iou_zone", "iou_brep", "steps", "time_to_best_s", "build_s",
-                           "search_s", "zones", "expansions"}
+    assert set(result) >= {
+        "status",
+        "exact",
+        "iou_zone",
+        "iou_brep",
+        "steps",
+        "time_to_best_s",
+        "build_s",
+        "search_s",
+        "zones",
+        "expansions",
+    }
     assert result["config"]["guide"] == "random"

@@ -52,7 +52,8 @@ _EXPORTS = {
     "SearchConfig": "zonegraph.sequence",
     "SearchResult": "zonegraph.sequence",
     "search": "zonegraph.sequence",
-    "InferConfig": "zonegraph.reconstruction",
+    "InferConfig": "zonegraph.configs",
+    "BuildConfig": "zonegraph.configs",
     "InferResult": "zonegraph.reconstruction",
     "Reconstruction": "zonegraph.reconstruction",
     "reconstruct": "zonegraph.reconstruction",
@@ -62,13 +63,29 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS)
 
 if TYPE_CHECKING:
+    from zonegraph.configs import BuildConfig, InferConfig
     from zonegraph.data import Design, load_design, load_target
     from zonegraph.data.replay import replay
     from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError, ZoneGraphError
-    from zonegraph.reconstruction import InferConfig, InferResult, Reconstruction, infer, reconstruct
-    from zonegraph.sequence import (HeuristicRanker, Op, Proposal, ProposalGenerator, RandomRanker, Ranker,
-                                    SearchConfig, SearchResult, search)
-    from zonegraph.zones import ZoneGraph, ZoneGraphBuildError, build_zone_graph, load_zone_graph, save_zone_graph
+    from zonegraph.reconstruction import InferResult, Reconstruction, infer, reconstruct
+    from zonegraph.sequence import (
+        HeuristicRanker,
+        Op,
+        Proposal,
+        ProposalGenerator,
+        RandomRanker,
+        Ranker,
+        SearchConfig,
+        SearchResult,
+        search,
+    )
+    from zonegraph.zones import (
+        ZoneGraph,
+        ZoneGraphBuildError,
+        build_zone_graph,
+        load_zone_graph,
+        save_zone_graph,
+    )
 
 
 def __getattr__(name: str) -> Any:

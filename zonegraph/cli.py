@@ -9,9 +9,10 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Callable, Sequence
 
+from zonegraph.configs import BuildConfig, InferConfig
 from zonegraph.errors import ZoneGraphError
 
 EXIT_USER_ERROR = 2
@@ -33,12 +34,16 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         write_step(step.tool, out / f"steps/{i:02d}_tool.step")
         summary["steps"][i]["step_file"] = name
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
-    print(f"{design.id}: {len(result.steps)} extrudes, {summary['body_count']} bodies, "
-          f"{summary['face_count']} faces, volume {summary['volume']:.6g} cm^3 -> {out}")
+    print(
+        f"{design.id}: {len(result.steps)} extrudes, {summary['body_count']} bodies, "
+        f"{summary['face_count']} faces, volume {summary['volume']:.6g} cm^3 -> {out}"
+    )
     check = summary.get("check")
     if check:
-        print(f"  vs Fusion properties: volume rel. error {check['volume_rel_error']:.1e}, "
-              f"area rel. error {check['area_rel_error']:.1e}")
+        print(
+            f"  vs Fusion properties: volume rel. error {check['volume_rel_error']:.1e}, "
+            f"area rel. error {check['area_rel_error']:.1e}"
+        )
     return 0
 
 
@@ -46,35 +51,42 @@ def _cmd_build(args: argparse.Namespace) -> int:
     from zonegraph.isolation import run_isolated
     from zonegraph.jobs import build_and_save
 
-    outcome = run_isolated(build_and_save, (args.target, args.out, not args.no_simplify, args.samples, args.seed),
-                           timeout=args.timeout)
+    config = BuildConfig(simplify=not args.no_simplify, samples=args.samples, seed=args.seed)
+    outcome = run_isolated(build_and_save, (args.target, args.out, config), timeout=args.timeout)
     if not outcome.ok:
         print(f"zonegraph: error: {args.target}: {outcome.status}: {outcome.reason}", file=sys.stderr)
         return EXIT_USER_ERROR
     s = outcome.value
-    print(f"{Path(args.target).name}: status {s['status']}, {s['zones']} zones ({s['inside_zones']} inside), "
-          f"{s['faces']} faces, {s['edges']} edges, {s['surfaces']} surfaces from {s['target_faces']} target faces"
-          f"{'' if s['simplified'] else ' (not simplified)'}")
+    print(
+        f"{Path(args.target).name}: status {s['status']}, {s['zones']} zones ({s['inside_zones']} inside), "
+        f"{s['faces']} faces, {s['edges']} edges, {s['surfaces']} surfaces "
+        f"from {s['target_faces']} target faces"
+        f"{'' if s['simplified'] else ' (not simplified)'}"
+    )
     laps = ", ".join(f"{k[:-2]} {v:.3f}" for k, v in s.items() if k.endswith("_s") and k != "build_s")
     print(f"  built in {s['build_s']:.3f} s ({laps}) -> {args.out}")
     return 0
 
 
 def _cmd_infer(args: argparse.Namespace) -> int:
-    from zonegraph.reconstruction import InferConfig, infer
     from zonegraph.isolation import run_isolated
+    from zonegraph.reconstruction import infer
 
-    config = InferConfig(args.guide, args.budget, args.k, args.k_decay, args.max_depth, args.seed, args.level)
-    timeout = args.timeout or 3 * args.budget + 300  # the build and the export are not budgeted
+    config = InferConfig.from_mapping(vars(args))
+    timeout = args.timeout or 3 * args.budget_s + 300  # the build and the export are not budgeted
     outcome = run_isolated(infer, (args.target, args.out, config), timeout=timeout)
     if not outcome.ok:
         print(f"zonegraph: error: {args.target}: {outcome.status}: {outcome.reason}", file=sys.stderr)
         return EXIT_USER_ERROR
     r = outcome.value
-    print(f"{Path(args.target).name}: {r['status']}, {r['steps']} steps ({', '.join(r['operations'])}), "
-          f"B-rep IoU {r['iou_brep']:.6f}, zone IoU {r['iou_zone']:.6f}")
-    print(f"  {r['zones']} zones, build {r['build_s']:.2f} s, search {r['search_s']:.2f} s "
-          f"(best after {r['time_to_best_s']:.2f} s, {r['expansions']} expansions) -> {args.out}")
+    print(
+        f"{Path(args.target).name}: {r.status}, {r.steps} steps ({', '.join(r.operations)}), "
+        f"B-rep IoU {r.iou_brep:.6f}, zone IoU {r.iou_zone:.6f}"
+    )
+    print(
+        f"  {r.zones} zones, build {r.build_s:.2f} s, search {r.search_s:.2f} s "
+        f"(best after {r.time_to_best_s:.2f} s, {r.expansions} expansions) -> {args.out}"
+    )
     return 0
 
 
@@ -89,21 +101,33 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("target", help="PART.step, PART.brep or DESIGN.json")
     p.add_argument("--out", required=True, help="output folder (Parquet tables and zones.brep)")
     p.add_argument("--no-simplify", action="store_true", help="extend face-loop walls as full planes")
-    p.add_argument("--samples", type=int, default=512, help="surface samples per zone")
-    p.add_argument("--seed", type=int, default=0, help="seed of the surface samples")
+    b = BuildConfig.defaults()
+    p.add_argument("--samples", type=int, default=b["samples"], help="surface samples per zone")
+    p.add_argument("--seed", type=int, default=b["seed"], help="seed of the surface samples")
     p.add_argument("--timeout", type=float, default=600.0, help="seconds before the build is stopped")
     p.set_defaults(func=_cmd_build)
+    d = InferConfig.defaults()
     p = sub.add_parser("infer", help="infer an editable sketch + extrude program that rebuilds a part")
     p.add_argument("target", help="PART.step, PART.brep or DESIGN.json (its final shape)")
     p.add_argument("--out", required=True, help="output folder (result.json, sequence.py/.json/.png, steps/)")
-    p.add_argument("--guide", choices=["heuristic", "random"], default="heuristic", help="proposal ranking")
-    p.add_argument("--budget", type=float, default=10.0, help="search seconds (zone graph build excluded)")
-    p.add_argument("--k", type=int, default=5, help="proposals kept per state (top-k)")
-    p.add_argument("--k-decay", type=float, default=0.0, help="k decrease per depth level")
-    p.add_argument("--max-depth", type=int, default=20, help="longest program searched")
-    p.add_argument("--seed", type=int, default=0, help="seed of the random guide")
-    p.add_argument("--level", type=int, default=1, help="proposal level (subsets of sketch components)")
-    p.add_argument("--timeout", type=float, default=None, help="hard stop in seconds (default 3 x budget + 300)")
+    p.add_argument("--guide", choices=["heuristic", "random"], default=d["guide"], help="proposal ranking")
+    p.add_argument(
+        "--budget",
+        dest="budget_s",
+        type=float,
+        default=d["budget_s"],
+        help="search seconds (zone graph build excluded)",
+    )
+    p.add_argument("--k", type=int, default=d["k"], help="proposals kept per state (top-k)")
+    p.add_argument("--k-decay", type=float, default=d["k_decay"], help="k decrease per depth level")
+    p.add_argument("--max-depth", type=int, default=d["max_depth"], help="longest program searched")
+    p.add_argument("--seed", type=int, default=d["seed"], help="seed of the random guide")
+    p.add_argument(
+        "--level", type=int, default=d["level"], help="proposal level (subsets of sketch components)"
+    )
+    p.add_argument(
+        "--timeout", type=float, default=None, help="hard stop in seconds (default 3 x budget + 300)"
+    )
     p.set_defaults(func=_cmd_infer)
     return parser
 

@@ -11,8 +11,10 @@ import multiprocessing as mp
 import os
 import time
 import traceback
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from multiprocessing.connection import Connection
+from typing import Any
 
 from zonegraph.errors import ZoneGraphError
 
@@ -29,14 +31,16 @@ class Outcome:
         return self.status == "ok"
 
 
-def _child(conn, fn: Callable, args: tuple) -> None:
+def _child(conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
     try:
         conn.send(("ok", fn(*args), ""))
     except ZoneGraphError as exc:
         conn.send((exc.status, None, exc.reason))
     except Exception as exc:  # a bug or an unexpected OCP failure: keep the reason, not the process
         last = traceback.extract_tb(exc.__traceback__)[-1]
-        conn.send(("error", None, f"{type(exc).__name__}: {exc} ({os.path.basename(last.filename)}:{last.lineno})"))
+        conn.send(
+            ("error", None, f"{type(exc).__name__}: {exc} ({os.path.basename(last.filename)}:{last.lineno})")
+        )
     finally:
         conn.close()
         os._exit(0)
@@ -55,11 +59,15 @@ def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -
     try:
         if not recv.poll(timeout):
             proc.kill()
-            return Outcome("timeout", reason=f"no result after {timeout:g} s", seconds=time.perf_counter() - t0)
+            return Outcome(
+                "timeout", reason=f"no result after {timeout:g} s", seconds=time.perf_counter() - t0
+            )
         status, value, reason = recv.recv()
     except EOFError:
         proc.join()
-        return Outcome("crash", reason=f"worker died (exit code {proc.exitcode})", seconds=time.perf_counter() - t0)
+        return Outcome(
+            "crash", reason=f"worker died (exit code {proc.exitcode})", seconds=time.perf_counter() - t0
+        )
     finally:
         recv.close()
         proc.join(5)

@@ -11,19 +11,21 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
-from build123d import Unit
+from build123d import Solid, Unit
 
+from zonegraph.configs import InferConfig
+from zonegraph.data.replay import as_shape
+from zonegraph.data.targets import load_target
 from zonegraph.export.writers import write_outputs
-from zonegraph.zones.build import build_zone_graph
+from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.program import RebuildError, brep_iou, build_program, execute
 from zonegraph.sequence.proposals import ProposalGenerator
-from zonegraph.data.replay import as_shape
-from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.rankers import make_ranker
-from zonegraph.data.targets import load_target
+from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.storage import load_zone_graph
 
@@ -31,15 +33,43 @@ EXACT_IOU = 0.9999
 FIRST_SHARE = 0.5  # of the budget, for the simplified graph
 
 
-@dataclass(frozen=True)
-class InferConfig:
-    guide: str = "heuristic"
-    budget_s: float = 10.0
-    k: int = 5
-    k_decay: float = 0.0
-    max_depth: int = 20
-    seed: int = 0
-    level: int = 1  # proposal level: sketches of 1..level and N-level..N components
+@dataclass
+class Reconstruction:
+    """The best search over a target's zone graphs, before rebuilding it as real geometry."""
+
+    graph: ZoneGraph  # the graph the best result was found on
+    generator: ProposalGenerator
+    result: SearchResult
+    build_s: float  # zone-graph build seconds (both graphs)
+    search_s: float  # search seconds (both graphs)
+    solids: list[Solid]  # the target, in the input's units
+
+
+@dataclass
+class InferResult:
+    """What ``zonegraph infer`` found: the contents of ``result.json``."""
+
+    status: str  # exact, partial or rebuild_failed
+    exact: bool  # exact on zones and rebuilt with B-rep IoU >= EXACT_IOU
+    iou_zone: float
+    iou_brep: float
+    steps: int
+    time_to_best_s: float
+    build_s: float
+    search_s: float
+    zones: int
+    simplified: bool
+    expansions: int
+    operations: list[str] = field(default_factory=list)  # union / subtract, in program order
+    rebuild_error: str = ""
+    config: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def _search_config(config: InferConfig, budget_s: float) -> SearchConfig:
+    return SearchConfig(k=config.k, k_decay=config.k_decay, max_depth=config.max_depth, budget_s=budget_s)
 
 
 def input_unit(path: Path) -> Unit:
@@ -47,7 +77,7 @@ def input_unit(path: Path) -> Unit:
     return Unit.CM if path.suffix.lower() == ".json" else Unit.MM
 
 
-def _graph(solids, simplify: bool, source: str, saved: Path | None) -> tuple[ZoneGraph, float]:
+def _graph(solids: list[Solid], simplify: bool, source: str, saved: Path | None) -> tuple[ZoneGraph, float]:
     """The zone graph and its build seconds; a graph saved by the pipeline is reused."""
     if saved is not None and (saved / "zones.parquet").is_file():
         graph = load_zone_graph(saved)
@@ -58,57 +88,101 @@ def _graph(solids, simplify: bool, source: str, saved: Path | None) -> tuple[Zon
     return graph, time.perf_counter() - t0
 
 
-def reconstruct(target_path: str | Path, config: InferConfig = InferConfig(), saved_graph: str | None = None):
-    """Search the zone graphs of a target; returns (graph, generator, result, build_s, search_s, solids)."""
+def reconstruct(
+    target_path: str | Path, config: InferConfig = InferConfig(), saved_graph: str | Path | None = None
+) -> Reconstruction:
+    """Search the simplified, then (if needed) the full zone graph of a target file.
+
+    Args:
+        target_path: a STEP, BREP or design JSON file.
+        config: search settings.
+        saved_graph: a folder holding this target's saved zone graph, reused instead of rebuilt.
+
+    Returns:
+        The best search (zone IoU, then fewest steps) and the graph it ran on.
+
+    Raises:
+        InputError: the file cannot be read as solids.
+        ZoneGraphBuildError: no zone graph could be built.
+    """
     solids = load_target(target_path)
     ranker = make_ranker(config.guide, config.seed)
-    best, build_s, search_s, error = None, 0.0, 0.0, None
+    saved = Path(saved_graph) if saved_graph else None
+    best: tuple[ZoneGraph, ProposalGenerator, SearchResult] | None = None
+    build_s, search_s = 0.0, 0.0
+    error: ZoneGraphBuildError | None = None
     for simplify in (True, False):
         try:
-            graph, seconds = _graph(solids, simplify, str(target_path), Path(saved_graph) if saved_graph else None)
+            graph, seconds = _graph(solids, simplify, str(target_path), saved)
         except ZoneGraphBuildError as exc:
             error = exc
             continue
         build_s += seconds
         left = config.budget_s - search_s
-        budget = left * FIRST_SHARE if simplify else left
         gen = ProposalGenerator(graph, level=config.level)
-        result = search(graph, ranker, SearchConfig(config.k, config.k_decay, config.max_depth, budget), gen)
+        result = search(graph, ranker, _search_config(config, left * FIRST_SHARE if simplify else left), gen)
         search_s += result.seconds
         if best is None or (result.iou, -len(result.steps)) > (best[2].iou, -len(best[2].steps)):
             best = (graph, gen, result)
         if result.exact or not graph.surface_strip.any():  # no face loop: the full graph is the same
             break
     if best is None:
+        assert error is not None
         raise error
-    return (*best, build_s, search_s, solids)
+    return Reconstruction(*best, build_s=build_s, search_s=search_s, solids=solids)
 
 
-def infer(target_path: str, out: str, config: InferConfig = InferConfig(), render: bool = True,
-          saved_graph: str | None = None) -> dict:
-    """Reconstruct, rebuild, verify and export; returns the contents of result.json.
+def infer(
+    target_path: str | Path,
+    out: str | Path,
+    config: InferConfig = InferConfig(),
+    render: bool = True,
+    saved_graph: str | Path | None = None,
+) -> InferResult:
+    """Reconstruct, rebuild, verify and export a target; writes ``result.json`` and the program.
 
-    ``render=False`` skips the per-step STEP files and the PNG (the pipeline's bulk runs);
-    ``saved_graph`` is a folder holding this target's zone graph, reused instead of rebuilt."""
+    Args:
+        target_path: a STEP, BREP or design JSON file.
+        out: output folder (result.json, sequence.py/.json, and when ``render`` steps/ and a PNG).
+        config: search settings.
+        render: write the per-step STEP files and the PNG (the pipeline's bulk runs skip them).
+        saved_graph: a folder holding this target's zone graph, reused instead of rebuilt.
+
+    Returns:
+        The result, also written to ``out/result.json``.
+
+    Raises:
+        InputError, ZoneGraphBuildError: as :func:`reconstruct`.
+    """
     path, out_dir = Path(target_path), Path(out)
-    graph, gen, result, build_s, search_s, solids = reconstruct(path, config, saved_graph)
-    program = build_program(graph, result.steps, gen)
-    states, rebuild_error, iou = [], "", 0.0
+    rec = reconstruct(path, config, saved_graph)
+    program = build_program(rec.graph, rec.result.steps, rec.generator)
+    states: list = []
+    rebuild_error, iou = "", 0.0
     try:
         states = execute(program)
-        iou = brep_iou(states[-1] if states else None, as_shape(solids))
+        iou = brep_iou(states[-1] if states else None, as_shape(rec.solids))
     except RebuildError as exc:
         rebuild_error = str(exc)
     if states:
         write_outputs(program, states, out_dir, path.stem, input_unit(path), render)
-    status = "rebuild_failed" if rebuild_error else "exact" if result.exact and iou >= EXACT_IOU else "partial"
-    summary = {
-        "status": status, "rebuild_error": rebuild_error,
-        "exact": bool(result.exact and iou >= EXACT_IOU), "iou_zone": result.iou, "iou_brep": iou,
-        "steps": len(program), "time_to_best_s": result.time_to_best_s, "build_s": build_s, "search_s": search_s,
-        "zones": graph.n_zones, "simplified": graph.info["simplified"], "expansions": result.expansions,
-        "operations": [s.op.name.lower() for s in program], "config": asdict(config),
-    }
+    exact = bool(rec.result.exact and iou >= EXACT_IOU)
+    result = InferResult(
+        status="rebuild_failed" if rebuild_error else "exact" if exact else "partial",
+        exact=exact,
+        iou_zone=rec.result.iou,
+        iou_brep=iou,
+        steps=len(program),
+        time_to_best_s=rec.result.time_to_best_s,
+        build_s=rec.build_s,
+        search_s=rec.search_s,
+        zones=rec.graph.n_zones,
+        simplified=bool(rec.graph.info["simplified"]),
+        expansions=rec.result.expansions,
+        operations=[s.op.name.lower() for s in program],
+        rebuild_error=rebuild_error,
+        config=asdict(config),
+    )
     out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "result.json").write_text(json.dumps(summary, indent=2))
-    return summary
+    (out_dir / "result.json").write_text(json.dumps(result.to_dict(), indent=2))
+    return result

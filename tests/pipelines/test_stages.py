@@ -10,7 +10,9 @@ import yaml
 
 
 def run_stage(module: str, cwd) -> str:
-    proc = subprocess.run([sys.executable, "-m", module], cwd=cwd, capture_output=True, text=True, timeout=600)
+    proc = subprocess.run(
+        [sys.executable, "-m", module], cwd=cwd, capture_output=True, text=True, timeout=600
+    )
     assert proc.returncode == 0, proc.stderr[-3000:]
     return proc.stdout
 

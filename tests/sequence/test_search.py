@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from build123d import Box, Cylinder, Pos
 
-from zonegraph.zones.build import build_zone_graph
-from zonegraph.sequence.proposals import Op, ProposalGenerator
 from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.sequence.rankers import HeuristicRanker, RandomRanker, zone_iou
+from zonegraph.zones.build import build_zone_graph
 
 
 def graph_of(part, simplify=True):
@@ -81,5 +81,20 @@ def test_heuristic_prefers_agreeing_proposals():
 
 def test_random_ranker_is_seeded():
     g = graph_of(Box(4, 4, 1) - Cylinder(1, 1))
-    runs = [search(g, RandomRanker(seed=5), SearchConfig(budget_s=5)) for _ in range(2)]
-    assert [[p.key for p in r.steps] for r in runs][0] == [[p.key for p in r.steps] for r in runs][1]
+    bounded = SearchConfig(budget_s=float("inf"), max_expansions=40)  # work, not wall clock, bounds it
+    runs = [search(g, RandomRanker(seed=5), bounded) for _ in range(2)]
+    assert [p.key for p in runs[0].steps] == [p.key for p in runs[1].steps]
+    assert runs[0].expansions == runs[1].expansions
+    assert runs[0].proposals_per_state == runs[1].proposals_per_state
+
+
+def test_proposals_compare_and_hash_by_what_they_do():
+    g = graph_of(Box(4, 4, 1) - Cylinder(1, 1), simplify=False)
+    gen = ProposalGenerator(g)
+    props = gen.proposals(np.zeros(g.n_zones, bool))
+    twin = Proposal(props[0].end, props[0].start, (), props[0].zones.copy(), props[0].op)
+    assert twin == props[0] and hash(twin) == hash(props[0])
+    assert len(set(props)) == len(props)  # the generator already removes duplicates
+    other = Proposal(props[0].start, props[0].end, props[0].faces, props[0].zones, Op(-props[0].op))
+    assert other != props[0]
+    assert repr(props[0]).startswith("Proposal(union") and "zones" in repr(g)

@@ -9,15 +9,14 @@ from OCP.BRepClass3d import BRepClass3d_SolidClassifier
 from OCP.TopAbs import TopAbs_FACE, TopAbs_IN
 from OCP.TopoDS import TopoDS
 
-from zonegraph.geometry.cells import fuse_zones
-from zonegraph.data.design import load_design
-from zonegraph.zones.face_loops import find_face_loops
-from zonegraph.geometry.occ import pnt, sub_shapes
-from zonegraph.zones.build import build_zone_graph
-from zonegraph.data.replay import replay
-from zonegraph.geometry.shapes import symmetric_difference_volume
-
 from tests.conftest import requires_samples, sample_paths
+from zonegraph.data.design import load_design
+from zonegraph.data.replay import replay
+from zonegraph.geometry.cells import fuse_zones
+from zonegraph.geometry.occ import pnt, sub_shapes
+from zonegraph.geometry.shapes import symmetric_difference_volume
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.zones.face_loops import find_face_loops
 
 DISTINCT = [p for p in sample_paths() if not p.stem.startswith(("SingleSketchExtrude_", "Z0HexagonCutJoin"))]
 
@@ -41,8 +40,17 @@ def test_invariants_on_real_samples(path, simplify):
 
 
 @requires_samples
-@pytest.mark.parametrize("name", ["Pattern2_6c40bf33_0000", "Pattern4_f830f176_0000", "Couch", "Hexagon",
-                                  "51022_47816098_0003", "Pattern4-SteppedStartEndFace_17dd857d_0000"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "Pattern2_6c40bf33_0000",
+        "Pattern4_f830f176_0000",
+        "Couch",
+        "Hexagon",
+        "51022_47816098_0003",
+        "Pattern4-SteppedStartEndFace_17dd857d_0000",
+    ],
+)
 def test_inside_zones_fuse_back_to_the_target(samples_dir, name):
     bodies = final_bodies(samples_dir / f"{name}.json")
     graph = build_zone_graph(bodies, samples=0)
@@ -65,10 +73,14 @@ def test_ring_zone_with_centroid_outside_is_labelled_inside():
     assert clf.State() == TopAbs_IN  # ...the verified interior point does not
 
 
-@pytest.mark.parametrize("part, full, simplified", [
-    (Box(6, 4, 2) - Box(2, 1, 2), 9, 2),  # through slot
-    (Box(6, 4, 2) - Pos(0, 0, 0.5) * Box(2, 1, 1), 18, 4),  # pocket
-], ids=["through-slot", "pocket"])
+@pytest.mark.parametrize(
+    "part, full, simplified",
+    [
+        (Box(6, 4, 2) - Box(2, 1, 2), 9, 2),  # through slot
+        (Box(6, 4, 2) - Pos(0, 0, 0.5) * Box(2, 1, 1), 18, 4),  # pocket
+    ],
+    ids=["through-slot", "pocket"],
+)
 def test_face_loop_simplification_lowers_zone_count(part, full, simplified):
     a = build_zone_graph(part, simplify=False, samples=0)
     b = build_zone_graph(part, simplify=True, samples=0)

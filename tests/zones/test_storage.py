@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from build123d import Box, Rectangle, export_step
 
-from zonegraph.errors import InputError
-from zonegraph.jobs import build_and_save
-from zonegraph.geometry.occ import volume_props
-from zonegraph.zones.build import build_zone_graph
 from zonegraph.data.targets import load_target
+from zonegraph.errors import InputError
+from zonegraph.geometry.occ import volume_props
+from zonegraph.jobs import build_and_save
+from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraphBuildError
 from zonegraph.zones.storage import load_zone_graph, save_zone_graph
 
@@ -30,7 +30,9 @@ def test_round_trip_is_equal(samples_dir, tmp_path):
         if f.name in ("zone_points", "zone_normals"):  # stored as float16: network inputs, not geometry
             np.testing.assert_allclose(a, b, atol=2e-3)
         elif f.name == "solids":
-            assert [volume_props(s)[0] for s in a] == pytest.approx([volume_props(s)[0] for s in b], rel=1e-12)
+            assert [volume_props(s)[0] for s in a] == pytest.approx(
+                [volume_props(s)[0] for s in b], rel=1e-12
+            )
         elif isinstance(a, np.ndarray):
             np.testing.assert_array_equal(a, b)
         else:
@@ -78,7 +80,9 @@ def test_cli_build_prints_counts_and_writes_the_graph(tmp_path):
     part = tmp_path / "plate.step"
     export_step(Box(4, 4, 1) - Box(1, 1, 1), str(part))
     out = tmp_path / "graph"
-    proc = subprocess.run([str(SCRIPT), "build", str(part), "--out", str(out)], capture_output=True, text=True)
+    proc = subprocess.run(
+        [str(SCRIPT), "build", str(part), "--out", str(out)], capture_output=True, text=True
+    )
     assert proc.returncode == 0, proc.stderr
     assert "status ok, 2 zones (1 inside)" in proc.stdout  # the through hole is one face loop
     graph = load_zone_graph(out)
@@ -86,16 +90,21 @@ def test_cli_build_prints_counts_and_writes_the_graph(tmp_path):
 
 
 @pytest.mark.skipif(not SCRIPT.exists(), reason=f"console script not installed at {SCRIPT}")
-@pytest.mark.parametrize("args, message", [
-    (["absent.step"], "no such file"),
-    (["sheet.step"], "not a solid"),
-    (["plate.step", "--timeout", "0.01"], "timeout"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["absent.step"], "no such file"),
+        (["sheet.step"], "not a solid"),
+        (["plate.step", "--timeout", "0.01"], "timeout"),
+    ],
+)
 def test_cli_build_errors_are_one_line(tmp_path, args, message):
     export_step(Rectangle(2, 1).faces()[0], str(tmp_path / "sheet.step"))
     export_step(Box(4, 4, 1) - Box(1, 1, 1), str(tmp_path / "plate.step"))
     args = [str(tmp_path / args[0]), *args[1:]]
-    proc = subprocess.run([str(SCRIPT), "build", *args, "--out", str(tmp_path / "o")], capture_output=True, text=True)
+    proc = subprocess.run(
+        [str(SCRIPT), "build", *args, "--out", str(tmp_path / "o")], capture_output=True, text=True
+    )
     assert proc.returncode == 2
     lines = [line for line in proc.stderr.splitlines() if line.startswith("zonegraph:")]
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr

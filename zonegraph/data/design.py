@@ -20,9 +20,9 @@ from typing import Any, Union
 
 import numpy as np
 
+from zonegraph.geometry.vec import Vec3
 from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError
 
-Vec3 = tuple[float, float, float]
 
 
 class Operation(str, enum.Enum):
@@ -59,10 +59,10 @@ class Frame:
         """3x3 matrix whose columns are the axes (local vector -> world vector)."""
         return np.column_stack([self.x_axis, self.y_axis, self.z_axis]).astype(float)
 
-    def point(self, p: Vec3) -> np.ndarray:
+    def point(self, p: Vec3 | np.ndarray) -> np.ndarray:
         return np.asarray(self.origin, float) + self.matrix @ np.asarray(p, float)
 
-    def vector(self, v: Vec3) -> np.ndarray:
+    def vector(self, v: Vec3 | np.ndarray) -> np.ndarray:
         return self.matrix @ np.asarray(v, float)
 
 
@@ -281,7 +281,7 @@ def parse_design(data: Any, design_id: str, source: str = "") -> Design:
         uuid = item.get("entity") if isinstance(item, dict) else None
         if uuid not in entities:
             raise DesignError(name, str(uuid), "timeline names an entity that does not exist")
-        timeline.append(_parse_entity(entities[uuid], uuid, name))
+        timeline.append(_parse_entity(entities[uuid], str(uuid), name))
     design = Design(design_id, tuple(timeline), _parse_properties(data.get("properties")), source)
     _check_references(design, name)
     return design
@@ -452,8 +452,8 @@ def curve_to_json(c: Curve) -> dict:
     raise TypeError(f"not a curve: {c!r}")
 
 
-def _extent_json(x: Extent, is_full_length: bool | None = None) -> dict:
-    out = {"type": "DistanceExtentDefinition",
+def _extent_json(x: Extent, is_full_length: bool | None = None) -> dict[str, Any]:
+    out: dict[str, Any] = {"type": "DistanceExtentDefinition",
            "distance": {"type": "ModelParameter", "value": x.distance, "role": "AlongDistance"},
            "taper_angle": {"type": "ModelParameter", "value": x.taper, "role": "TaperAngle"}}
     if is_full_length is not None:

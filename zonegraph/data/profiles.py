@@ -19,6 +19,7 @@ from OCP.gp import gp_Ax2, gp_Dir, gp_Elips, gp_Pnt
 from OCP.collections import Array1_double, Array1_gp_Pnt, Array1_int
 
 from zonegraph.data.design import Arc, Circle, Curve, Ellipse, EllipticalArc, Frame, Line, Loop, Nurbs, Profile
+from zonegraph.geometry.vec import Vec3
 from zonegraph.errors import DesignError, UnsupportedFeatureError
 
 SNAP_TOL = 1e-5  # cm; Fusion's float32 noise is ~1e-7, real gaps are far larger
@@ -39,7 +40,7 @@ class _Snapper:
     def __init__(self) -> None:
         self.points: list[np.ndarray] = []
 
-    def __call__(self, p) -> np.ndarray:
+    def __call__(self, p: Vec3 | np.ndarray) -> np.ndarray:
         p = np.asarray(p, float)
         for q in self.points:
             if np.linalg.norm(p - q) < SNAP_TOL:

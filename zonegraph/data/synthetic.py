@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import math
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-from build123d import Face, GeomType, Shape, Solid
+from build123d import Face, GeomType, Shape, Solid, Vector
 
 from zonegraph.data.design import (
     Arc, Circle, Curve, Design, Ellipse, Extent, ExtentType, Extrude, Frame, Line, Loop, Nurbs,
@@ -301,10 +303,10 @@ class _Builder:
         size = face_size * self.u(0.2, 0.8)
         depth = diag * (self.u(0.05, 0.4) if op is Operation.JOIN else self.u(0.05, 1.2))
         sketch = self.sketch(frame, size, (0.0, 0.0))
-        fields = dict(extent_type=ExtentType.ONE_SIDE,
-                      extent_one=Extent((outward if op is Operation.JOIN else -outward) * depth))
-        if op is Operation.JOIN and self.rng.random() < self.cfg.p_taper:
-            fields["extent_one"] = Extent(fields["extent_one"].distance, math.radians(self.u(-8, 8)))
+        distance = (outward if op is Operation.JOIN else -outward) * depth
+        tapered = op is Operation.JOIN and self.rng.random() < self.cfg.p_taper
+        taper = math.radians(self.u(-8, 8)) if tapered else 0.0
+        fields = dict(extent_type=ExtentType.ONE_SIDE, extent_one=Extent(distance, taper))
         return self.extrude(sketch, op, fields)
 
     def plane_step(self, op: Operation, shape: Shape, diag: float) -> tuple[Sketch, Extrude]:
@@ -392,9 +394,10 @@ def generate_design(design_id: str, seed: int, cfg: SyntheticConfig = SyntheticC
                                     "seed": seed})
 
 
-def step_labels(step: ReplayStep, new_id) -> dict:
+def step_labels(step: ReplayStep, new_id: Callable[[], str]) -> dict[str, Any]:
     """The ``bodies``/``faces`` labels Fusion records after an extrude (fresh ids per step)."""
-    faces, bodies = {}, {}
+    faces: dict[str, Any] = {}
+    bodies: dict[str, Any] = {}
     for b, body in enumerate(step.bodies):
         ids = []
         for face in body.faces():
@@ -406,7 +409,7 @@ def step_labels(step: ReplayStep, new_id) -> dict:
     return {"bodies": bodies, "faces": faces}
 
 
-def _point(v) -> dict:
+def _point(v: Vector) -> dict[str, Any]:
     return {"type": "Point3D", "x": v.X, "y": v.Y, "z": v.Z}
 
 

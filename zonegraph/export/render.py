@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -11,7 +13,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from build123d import Shape  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
-
 from OCP.BRepMesh import BRepMesh_IncrementalMesh  # noqa: E402
 from OCP.TopAbs import TopAbs_FACE  # noqa: E402
 
@@ -26,38 +27,47 @@ COLOURS = {"shape": (0.6, 0.6, 0.6), Op.UNION: (0.2, 0.7, 0.3), Op.SUBTRACT: (0.
 def _triangles(shape: Shape, tolerance: float) -> np.ndarray:
     """Triangle corners (T, 3, 3); faces that fail to mesh are left out rather than failing."""
     BRepMesh_IncrementalMesh(shape.wrapped, tolerance, False, 0.5, False)
-    corners = [nodes[tris] for nodes, tris in (face_triangles(f) for f in sub_shapes(shape.wrapped, TopAbs_FACE))
-               if len(tris)]
+    corners = [
+        nodes[tris]
+        for nodes, tris in (face_triangles(f) for f in sub_shapes(shape.wrapped, TopAbs_FACE))
+        if len(tris)
+    ]
     return np.concatenate(corners) if corners else np.zeros((0, 3, 3))
 
 
-def _draw(ax, tris: np.ndarray, colour, alpha: float) -> None:
+def _draw(ax: Any, tris: np.ndarray, colour: Sequence[float], alpha: float) -> None:
     if not len(tris):
         return
     n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
     shade = 0.45 + 0.55 * np.abs(n @ LIGHT)
-    ax.add_collection3d(Poly3DCollection(tris, facecolors=np.clip(np.outer(shade, colour), 0, 1),
-                                         edgecolor="none", alpha=alpha))
+    ax.add_collection3d(
+        Poly3DCollection(
+            tris, facecolors=np.clip(np.outer(shade, colour), 0, 1), edgecolor="none", alpha=alpha
+        )
+    )
 
 
-def render_sequence(program: list[ProgramStep], states: list[Shape | None], path: Path) -> Path:
+def render_sequence(program: list[ProgramStep], states: Sequence[Shape | None], path: Path) -> Path:
     tools = [step.tool() for step in program]
     boxes = [s.bounding_box() for s in [*tools, *[x for x in states if x is not None]]]
     lo = np.min([tuple(b.min) for b in boxes], axis=0)
     hi = np.max([tuple(b.max) for b in boxes], axis=0)
     tol = 2e-3 * float(np.linalg.norm(hi - lo))
     fig = plt.figure(figsize=(3.2 * len(program) + 0.4, 3.6))
-    for i, (step, tool) in enumerate(zip(program, tools)):
+    for i, (step, tool) in enumerate(zip(program, tools, strict=False)):
         ax = fig.add_subplot(1, len(program), i + 1, projection="3d")
-        if i > 0 and states[i - 1] is not None:
-            _draw(ax, _triangles(states[i - 1], tol), COLOURS["shape"], 0.35)
+        previous = states[i - 1] if i > 0 else None
+        if previous is not None:
+            _draw(ax, _triangles(previous, tol), COLOURS["shape"], 0.35)
         _draw(ax, _triangles(tool, tol), COLOURS[step.op], 0.8)
         centre, half = (lo + hi) / 2, float((hi - lo).max()) / 2
-        for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+        for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=False):
             setter(c - half, c + half)
         ax.set_axis_off()
-        ax.set_title(f"{i + 1}: {'union' if step.op is Op.UNION else 'subtract'} {step.distance:.3g}", fontsize=9)
+        ax.set_title(
+            f"{i + 1}: {'union' if step.op is Op.UNION else 'subtract'} {step.distance:.3g}", fontsize=9
+        )
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -9,20 +9,36 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from build123d import Edge, Face, GeomType, Shape, Unit
+from build123d import Edge, Face, GeomType, Shape, Unit, Vector
 
 from zonegraph.data.design import (
-    Arc, Circle, Curve, Design, Extent, ExtentType, Extrude, Frame, Line, Loop, Nurbs, Operation,
-    Profile, ProfileRef, Sketch, design_to_json,
+    Arc,
+    Circle,
+    Curve,
+    Design,
+    Extent,
+    ExtentType,
+    Extrude,
+    Frame,
+    Line,
+    Loop,
+    Nurbs,
+    Operation,
+    Profile,
+    ProfileRef,
+    Sketch,
+    design_to_json,
 )
-from zonegraph.sequence.program import ProgramStep
-from zonegraph.sequence.proposals import Op
 from zonegraph.export.render import render_sequence
 from zonegraph.geometry.shapes import write_step
+from zonegraph.geometry.vec import vec3
+from zonegraph.sequence.program import ProgramStep
+from zonegraph.sequence.proposals import Op
 
 
 def step_frame(step: ProgramStep) -> Frame:
@@ -33,7 +49,7 @@ def step_frame(step: ProgramStep) -> Frame:
     return Frame(step.origin, tuple(x), tuple(np.cross(z, x)), tuple(z))
 
 
-def _local(frame: Frame, p) -> np.ndarray:
+def _local(frame: Frame, p: Sequence[float] | np.ndarray | Vector) -> np.ndarray:
     return frame.matrix.T @ (np.asarray(tuple(p), float) - np.asarray(frame.origin, float))
 
 
@@ -53,7 +69,9 @@ def local_edges(edge: Edge, frame: Frame) -> LocalEdge:
     if kind == GeomType.CIRCLE:
         if edge.is_closed:
             return LocalEdge("circle", np.array([_local(frame, edge.arc_center)]), edge.radius)
-        return LocalEdge("arc", np.array([_local(frame, edge.position_at(t)) for t in (0, 0.5, 1)]), edge.radius)
+        return LocalEdge(
+            "arc", np.array([_local(frame, edge.position_at(t)) for t in (0, 0.5, 1)]), edge.radius
+        )
     return LocalEdge("spline", np.array([_local(frame, edge.position_at(t)) for t in np.linspace(0, 1, 24)]))
 
 
@@ -74,7 +92,7 @@ def _xy(p: np.ndarray) -> str:
     return f"({p[0]:.12g}, {p[1]:.12g})"
 
 
-def _vec(v) -> str:
+def _vec(v: Sequence[float] | np.ndarray) -> str:
     return "(" + ", ".join(f"{float(c):.12g}" for c in v) + ")"
 
 
@@ -105,19 +123,29 @@ def program_script(program: list[ProgramStep], name: str, unit: Unit) -> str:
         frame = step_frame(step)
         verb = "union" if step.op is Op.UNION else "subtract"
         lines.append(f"    # Step {i}: {verb}, extrude {step.distance:.6g} along the sketch normal")
-        lines.append(f"    with BuildSketch(Plane(origin={_vec(frame.origin)}, x_dir={_vec(frame.x_axis)}, "
-                     f"z_dir={_vec(frame.z_axis)})):")
+        lines.append(
+            f"    with BuildSketch(Plane(origin={_vec(frame.origin)}, x_dir={_vec(frame.x_axis)}, "
+            f"z_dir={_vec(frame.z_axis)})):"
+        )
         for face in step.faces:
             for outer, edges in face_loops(face, frame):
                 lines.append("        with BuildLine(mode=Mode.PRIVATE) as loop:")
                 lines += [f"            {_edge_code(e)}" for e in edges]
-                lines.append("        make_face(loop.edges())" if outer else
-                             "        make_face(loop.edges(), mode=Mode.SUBTRACT)")
+                lines.append(
+                    "        make_face(loop.edges())"
+                    if outer
+                    else "        make_face(loop.edges(), mode=Mode.SUBTRACT)"
+                )
         mode = "Mode.ADD" if step.op is Op.UNION else "Mode.SUBTRACT"
         lines.append(f"    extrude(amount={step.distance:.12g}, mode={mode})")
         lines.append("")
-    lines += ["result = part.part", "", 'if __name__ == "__main__" and len(sys.argv) > 1:',
-              f"    export_step(result, sys.argv[1], unit=Unit.{unit.name})", ""]
+    lines += [
+        "result = part.part",
+        "",
+        'if __name__ == "__main__" and len(sys.argv) > 1:',
+        f"    export_step(result, sys.argv[1], unit=Unit.{unit.name})",
+        "",
+    ]
     return "\n".join(lines)
 
 
@@ -125,7 +153,7 @@ def program_script(program: list[ProgramStep], name: str, unit: Unit) -> str:
 
 
 def _curve(e: LocalEdge, edge: Edge, frame: Frame) -> Curve:
-    p = [tuple(float(v) for v in q) for q in e.points]
+    p = [vec3(q) for q in e.points]
     if e.kind == "line":
         return Line(p[0], p[1])
     if e.kind == "circle":
@@ -137,29 +165,41 @@ def _curve(e: LocalEdge, edge: Edge, frame: Frame) -> Curve:
         ref = a / np.linalg.norm(a)
         perp = np.cross((0.0, 0.0, sign), ref)
         sweep = math.atan2(float(b @ perp), float(b @ ref)) % (2 * math.pi) or 2 * math.pi
-        return Arc(p[0], p[2], tuple(centre), e.radius, (0.0, 0.0, sign), 0.0, sweep, tuple(ref))
+        return Arc(p[0], p[2], vec3(centre), e.radius, (0.0, 0.0, sign), 0.0, sweep, vec3(ref))
     spline = edge.to_splines()
     geom = spline.geom_adaptor().BSpline()
     poles = [_local(frame, (q.X(), q.Y(), q.Z())) for q in geom.Poles()]
-    knots = [k for k, m in zip(geom.Knots(), geom.Multiplicities()) for _ in range(m)]
+    knots = [k for k, m in zip(geom.Knots(), geom.Multiplicities(), strict=False) for _ in range(m)]
     weights = list(geom.Weights()) if geom.IsRational() else None
-    return Nurbs(geom.Degree(), tuple(knots), tuple(tuple(float(v) for v in q) for q in poles),
-                 tuple(weights) if weights else None)
+    return Nurbs(
+        geom.Degree(),
+        tuple(knots),
+        tuple(vec3(q) for q in poles),
+        tuple(weights) if weights else None,
+    )
 
 
 def program_design(program: list[ProgramStep], name: str) -> Design:
-    timeline = []
+    timeline: list[Sketch | Extrude] = []
     for i, step in enumerate(program):
         frame = step_frame(step)
         profiles = {}
         for j, face in enumerate(step.faces):
-            loops = tuple(Loop(outer, tuple(_curve(local_edges(e, frame), e, frame) for e in edges))
-                          for outer, edges in face_wires(face))
+            loops = tuple(
+                Loop(outer, tuple(_curve(local_edges(e, frame), e, frame) for e in edges))
+                for outer, edges in face_wires(face)
+            )
             profiles[f"profile{i}_{j}"] = Profile(f"profile{i}_{j}", loops, face.area)
         sketch = Sketch(f"sketch{i}", f"Sketch{i + 1}", frame, profiles)
         op = (Operation.NEW_BODY if i == 0 else Operation.JOIN) if step.op is Op.UNION else Operation.CUT
-        extrude = Extrude(f"extrude{i}", f"Extrude{i + 1}", tuple(ProfileRef(sketch.id, p) for p in profiles),
-                          op, ExtentType.ONE_SIDE, Extent(step.distance))
+        extrude = Extrude(
+            f"extrude{i}",
+            f"Extrude{i + 1}",
+            tuple(ProfileRef(sketch.id, p) for p in profiles),
+            op,
+            ExtentType.ONE_SIDE,
+            Extent(step.distance),
+        )
         timeline += [sketch, extrude]
     return Design(name, tuple(timeline))
 
@@ -167,8 +207,9 @@ def program_design(program: list[ProgramStep], name: str) -> Design:
 # ------------------------------------------------------------------------------ STEP and PNG
 
 
-def write_outputs(program: list[ProgramStep], states: list[Shape], out: Path, name: str, unit: Unit,
-                  render: bool = True) -> None:
+def write_outputs(
+    program: list[ProgramStep], states: list[Shape], out: Path, name: str, unit: Unit, render: bool = True
+) -> None:
     """sequence.py, sequence.json and, when ``render``, steps/NN.step and sequence.png.
 
     ``unit`` is what the input's numbers mean (mm for STEP as read, cm for a design JSON); the

@@ -6,7 +6,14 @@ The lowest layer: it imports nothing else from ``zonegraph`` but :mod:`zonegraph
 
 from zonegraph.geometry.cells import fuse_zones
 from zonegraph.geometry.normalize import Normalization
-from zonegraph.geometry.shapes import read_shape, read_solids, symmetric_difference_volume, volume_of, write_brep, write_step
+from zonegraph.geometry.shapes import (
+    read_shape,
+    read_solids,
+    symmetric_difference_volume,
+    volume_of,
+    write_brep,
+    write_step,
+)
 
 __all__ = [
     "Normalization",

@@ -7,7 +7,7 @@ face, so the result has the target's faces, not the zones'.
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 from OCP.BOPAlgo import BOPAlgo_CellsBuilder
 from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain

@@ -15,6 +15,7 @@ from OCP.gp import gp_Trsf
 from OCP.TopoDS import TopoDS_Shape
 
 from zonegraph.geometry.occ import bounds, pnt, vec
+from zonegraph.geometry.vec import vec3
 
 
 @dataclass(frozen=True)
@@ -25,11 +26,11 @@ class Normalization:
     scale: float
 
     @classmethod
-    def of(cls, shape: TopoDS_Shape) -> "Normalization":
+    def of(cls, shape: TopoDS_Shape) -> Normalization:
         b = bounds(shape)
         lo, hi = b[:3], b[3:]
         diag = float(np.linalg.norm(hi - lo))
-        return cls(tuple(float(v) for v in (lo + hi) / 2), 1.0 / diag)
+        return cls(vec3((lo + hi) / 2), 1.0 / diag)
 
     def trsf(self, inverse: bool = False) -> gp_Trsf:
         move, scale = gp_Trsf(), gp_Trsf()

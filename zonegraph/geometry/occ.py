@@ -2,39 +2,43 @@
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 from OCP.Bnd import Bnd_Box
+from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepGProp import BRepGProp
-from OCP.GProp import GProp_GProps
-from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
-from OCP.TopAbs import TopAbs_ShapeEnum
-from OCP.TopExp import TopExp, TopExp_Explorer
-from OCP.BRep import BRep_Builder, BRep_Tool
-from OCP.TopLoc import TopLoc_Location
-from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Shape
 from OCP.collections import (
     IndexedDataMap_TopoDS_Shape_List_TopoDS_Shape_TopTools_ShapeMapHasher as AncestorMap,
+)
+from OCP.collections import (
     IndexedMap_TopoDS_Shape_TopTools_ShapeMapHasher as ShapeIndex,
+)
+from OCP.collections import (
     List_TopoDS_Shape as ShapeList,
 )
+from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
+from OCP.GProp import GProp_GProps
+from OCP.TopAbs import TopAbs_ShapeEnum
+from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Shape
 
 
-def pnt(p) -> gp_Pnt:
+def pnt(p: Sequence[float] | np.ndarray) -> gp_Pnt:
     return gp_Pnt(float(p[0]), float(p[1]), float(p[2]))
 
 
-def direction(v) -> gp_Dir:
+def direction(v: Sequence[float] | np.ndarray) -> gp_Dir:
     return gp_Dir(float(v[0]), float(v[1]), float(v[2]))
 
 
-def vec(v) -> gp_Vec:
+def vec(v: Sequence[float] | np.ndarray) -> gp_Vec:
     return gp_Vec(float(v[0]), float(v[1]), float(v[2]))
 
 
-def xyz(p) -> np.ndarray:
+def xyz(p: gp_Pnt | gp_Dir | gp_Vec) -> np.ndarray:
     return np.array([p.X(), p.Y(), p.Z()])
 
 
@@ -103,7 +107,7 @@ def bounds(shape: TopoDS_Shape, optimal: bool = True) -> np.ndarray:
     return np.concatenate([xyz(box.CornerMin()), xyz(box.CornerMax())])
 
 
-def make_compound(shapes) -> TopoDS_Compound:
+def make_compound(shapes: Iterable[TopoDS_Shape]) -> TopoDS_Compound:
     comp = TopoDS_Compound()
     builder = BRep_Builder()
     builder.MakeCompound(comp)
@@ -112,7 +116,7 @@ def make_compound(shapes) -> TopoDS_Compound:
     return comp
 
 
-def face_triangles(face) -> tuple[np.ndarray, np.ndarray]:
+def face_triangles(face: TopoDS_Shape) -> tuple[np.ndarray, np.ndarray]:
     """Mesh nodes (N, 3) and triangles (T, 3) of a meshed face; empty if it has no mesh."""
     loc = TopLoc_Location()
     tri = BRep_Tool.Triangulation_s(TopoDS.Face(face), loc)

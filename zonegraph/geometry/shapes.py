@@ -71,7 +71,7 @@ def symmetric_difference_volume(a: Shape, b: Shape) -> float:
     return volume_of(a.cut(b)) + volume_of(b.cut(a))
 
 
-def volume_of(shape) -> float:
+def volume_of(shape: Shape | list[Shape] | None) -> float:
     """Volume of a Boolean result: a shape, a list of shapes (build123d's intersect) or None."""
     if shape is None:
         return 0.0

@@ -11,8 +11,8 @@ zone IoU, then fewest steps. The anytime trace of (seconds, best IoU) feeds IoU-
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
-from typing import Iterator
+from collections.abc import Iterator
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -54,14 +54,18 @@ class _Frame:
     children: Iterator[Proposal]
 
 
-def search(graph: ZoneGraph, ranker: Ranker, config: SearchConfig = SearchConfig(),
-           generator: ProposalGenerator | None = None) -> SearchResult:
+def search(
+    graph: ZoneGraph,
+    ranker: Ranker,
+    config: SearchConfig = SearchConfig(),
+    generator: ProposalGenerator | None = None,
+) -> SearchResult:
     """Find a proposal sequence whose canvas equals the target's zones."""
     gen = generator or ProposalGenerator(graph)
     target = graph.zone_inside.astype(bool)
     t0 = time.perf_counter()
     empty = np.zeros(graph.n_zones, bool)
-    best = (zone_iou(graph, empty, target), 0, empty, [])
+    best: tuple[float, int, np.ndarray, list[Proposal]] = (zone_iou(graph, empty, target), 0, empty, [])
     trace = [(0.0, best[0])]
     time_to_best = 0.0
     seen = {np.packbits(empty).tobytes()}
@@ -73,10 +77,10 @@ def search(graph: ZoneGraph, ranker: Ranker, config: SearchConfig = SearchConfig
         used = {p.inverse_key for p in path}
         props = [p for p in gen.proposals(canvas) if p.key not in used]
         counts.append(len(props))
-        order = []
+        order: list[int] = []
         if props:
             scores = np.asarray(ranker.score(graph, canvas, props), float)
-            order = np.argsort(-scores, kind="stable")[: config.k_at(len(path))]
+            order = np.argsort(-scores, kind="stable")[: config.k_at(len(path))].tolist()
         times.append(time.perf_counter() - start)
         return iter([props[i] for i in order])
 
@@ -108,7 +112,14 @@ def search(graph: ZoneGraph, ranker: Ranker, config: SearchConfig = SearchConfig
         if len(path) < config.max_depth:
             stack.append(_Frame(canvas, path, expand(canvas, path)))
     return SearchResult(
-        exact=exact, iou=best[0], steps=best[3], canvas=best[2], expansions=len(counts),
-        seconds=time.perf_counter() - t0, time_to_best_s=time_to_best, trace=trace,
-        proposals_per_state=counts, expansion_s=times,
+        exact=exact,
+        iou=best[0],
+        steps=best[3],
+        canvas=best[2],
+        expansions=len(counts),
+        seconds=time.perf_counter() - t0,
+        time_to_best_s=time_to_best,
+        trace=trace,
+        proposals_per_state=counts,
+        expansion_s=times,
     )

@@ -15,8 +15,9 @@ from build123d import Face, Shape, Solid, Vector
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 
 from zonegraph.geometry.occ import ancestors, make_compound
-from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.geometry.shapes import volume_of
+from zonegraph.geometry.vec import vec3
+from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
 
 
@@ -58,12 +59,21 @@ def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGe
     norm = graph.normalization
     out = []
     for p in steps:
-        sketch = [Shape.cast(norm.apply(f.wrapped, inverse=True)) for f in merge_faces([faces[i] for i in p.faces])]
+        sketch = [
+            Shape.cast(norm.apply(f.wrapped, inverse=True)) for f in merge_faces([faces[i] for i in p.faces])
+        ]
         d = generator.direction(p.start, p.end) / norm.scale
         length = float(np.linalg.norm(d))
         origin = norm.to_original(graph.surface_normal[p.start] * graph.surface_offset[p.start])
-        out.append(ProgramStep(p.op, tuple(sketch), tuple(float(v) for v in origin),
-                               tuple(float(v) for v in d / length), length))
+        out.append(
+            ProgramStep(
+                p.op,
+                tuple(sketch),
+                vec3(origin),
+                vec3(d / length),
+                length,
+            )
+        )
     return out
 
 
@@ -104,4 +114,3 @@ def brep_iou(a: Shape | None, b: Shape) -> float:
             raise RebuildError("Booleans against the target failed; IoU unknown") from None
     union = a.volume + b.volume - inter
     return inter / union if union > 0 else 1.0
-

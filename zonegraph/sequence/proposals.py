@@ -36,9 +36,16 @@ class Op(enum.IntEnum):
     SUBTRACT = -1
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False, repr=False)
 class Proposal:
-    """One candidate operation: extrude ``faces`` on plane ``start`` to plane ``end``."""
+    """One candidate operation: extrude ``faces`` on plane ``start`` to plane ``end``.
+
+    Two proposals are equal (and hash alike) when they do the same thing to any canvas: the same
+    extrusion volume with the same operation, whichever sketch produced it (:attr:`key`).
+
+    Shapes:
+        zones: (Z,) bool over the zone graph's zones.
+    """
 
     start: int  # surface index of the start plane
     end: int  # surface index of the end plane
@@ -53,10 +60,24 @@ class Proposal:
 
     @cached_property
     def inverse_key(self) -> tuple[bytes, int]:
+        """The key of the operation that undoes this one (the same volume, the other operation)."""
         return self.key[0], -int(self.op)
 
     def apply(self, canvas: np.ndarray) -> np.ndarray:
+        """The canvas after this operation: (Z,) bool in, (Z,) bool out."""
         return canvas | self.zones if self.op is Op.UNION else canvas & ~self.zones
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Proposal) and self.key == other.key
+
+    def __hash__(self) -> int:
+        return hash(self.key)
+
+    def __repr__(self) -> str:
+        return (
+            f"Proposal({self.op.name.lower()}, plane {self.start} -> {self.end}, "
+            f"{len(self.faces)} sketch faces, {int(self.zones.sum())} zones)"
+        )
 
 
 class ProposalGenerator:
@@ -160,7 +181,10 @@ class ProposalGenerator:
                     if other < 0:
                         return None
                     stack.append(int(other))
-        if abs(float(g.zone_volume[zones].sum()) - g.face_area[face] * length) > PRISM_RTOL * g.face_area[face] * length:
+        if (
+            abs(float(g.zone_volume[zones].sum()) - g.face_area[face] * length)
+            > PRISM_RTOL * g.face_area[face] * length
+        ):
             return None
         return zones
 

@@ -11,9 +11,11 @@ can lie outside them.
 from __future__ import annotations
 
 import time
-from typing import Sequence
+from collections.abc import Iterator, Sequence
+from typing import Any, TypeAlias
 
 import numpy as np
+from build123d import Shape
 from OCP.BOPAlgo import BOPAlgo_Builder
 from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepClass3d import BRepClass3d_SolidClassifier
@@ -21,12 +23,24 @@ from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
 from OCP.GeomAbs import GeomAbs_Cylinder, GeomAbs_Plane
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN, TopAbs_INTERNAL, TopAbs_REVERSED, TopAbs_SOLID
-from OCP.TopoDS import TopoDS, TopoDS_Shape
+from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
-from zonegraph.zones.extension import ExtendedSurface, SurfaceKind, canonical, extend_faces, parallel
 from zonegraph.geometry.normalize import Normalization
-from zonegraph.geometry.occ import (ShapeList, ancestors, bounds, face_triangles, make_compound, pnt, shape_index, shapes_of, sub_shapes,
-                  surface_props, volume_props, xyz)
+from zonegraph.geometry.occ import (
+    ShapeList,
+    ancestors,
+    bounds,
+    face_triangles,
+    make_compound,
+    pnt,
+    shape_index,
+    shapes_of,
+    sub_shapes,
+    surface_props,
+    volume_props,
+    xyz,
+)
+from zonegraph.zones.extension import ExtendedSurface, SurfaceKind, canonical, extend_faces, parallel
 from zonegraph.zones.model import BuildStatus, ZoneGraph, ZoneGraphBuildError
 
 # Fuzzy values of the general fuse, in normalised units, tried in turn: 1e-7..1e-5 leave zone counts
@@ -48,15 +62,20 @@ class _Timer:
         self.t = now
 
 
-def _target_shape(target, source: str) -> TopoDS_Shape:
+Target: TypeAlias = "Shape | TopoDS_Shape | Sequence[Shape | TopoDS_Shape]"
+
+
+def _target_shape(target: Target, source: str) -> TopoDS_Shape:
     """The solids of ``target`` (a build123d shape, a TopoDS shape or a list of either)."""
-    items = target if isinstance(target, (list, tuple)) else [target]
+    items: Sequence[Shape | TopoDS_Shape] = target if isinstance(target, (list, tuple)) else [target]
     shapes = [getattr(t, "wrapped", t) for t in items]
     if not shapes or any(s is None or s.IsNull() for s in shapes):
         raise ZoneGraphBuildError(BuildStatus.INVALID_INPUT, source, "empty shape")
     solids = [s for shape in shapes for s in sub_shapes(shape, TopAbs_SOLID)]
     if not solids:
-        raise ZoneGraphBuildError(BuildStatus.NOT_A_SOLID, source, "no solid in the shape (a sheet, wire or empty file?)")
+        raise ZoneGraphBuildError(
+            BuildStatus.NOT_A_SOLID, source, "no solid in the shape (a sheet, wire or empty file?)"
+        )
     return make_compound(solids)
 
 
@@ -69,14 +88,16 @@ class _Unsplit:
     def Shape(self) -> TopoDS_Shape:  # noqa: N802 (mirrors BOPAlgo_Builder)
         return self.box_solid
 
-    def IsDeleted(self, shape) -> bool:  # noqa: N802
+    def IsDeleted(self, shape: TopoDS_Shape) -> bool:  # noqa: N802
         return False
 
-    def Modified(self, shape) -> ShapeList:  # noqa: N802
+    def Modified(self, shape: TopoDS_Shape) -> ShapeList:  # noqa: N802
         return ShapeList()
 
 
-def _fuse(box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface], fuzzy: float, source: str):
+def _fuse(
+    box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface], fuzzy: float, source: str
+) -> BOPAlgo_Builder | _Unsplit:
     if not any(s.sheets for s in surfaces):
         return _Unsplit(box_solid)
     builder = BOPAlgo_Builder()
@@ -93,9 +114,16 @@ def _fuse(box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface], fuzzy: float
     return builder
 
 
-def build_zone_graph(target, simplify: bool = True, samples: int = 512, seed: int = 0,
-                     fuzzy: Sequence[float] = FUZZY_LADDER, source: str = "target", keep_solids: bool = True,
-                     check: bool = True) -> ZoneGraph:
+def build_zone_graph(
+    target: Target,
+    simplify: bool = True,
+    samples: int = 512,
+    seed: int = 0,
+    fuzzy: Sequence[float] = FUZZY_LADDER,
+    source: str = "target",
+    keep_solids: bool = True,
+    check: bool = True,
+) -> ZoneGraph:
     """The zone graph of ``target``; raises ZoneGraphBuildError with a status on failure.
 
     The general fuse occasionally fails quietly (it drops splits it cannot compute), which only
@@ -112,11 +140,18 @@ def build_zone_graph(target, simplify: bool = True, samples: int = 512, seed: in
     box = bounds(target_n)
     surfaces, n_target_faces = extend_faces(target_n, box, simplify)
     timer.lap("extend_s")
-    info = {"status": "ok", "simplified": simplify, "target_faces": n_target_faces, "target_solids": len(solids)}
+    info = {
+        "status": "ok",
+        "simplified": simplify,
+        "target_faces": n_target_faces,
+        "target_solids": len(solids),
+    }
     ladder = [fuzzy] if isinstance(fuzzy, float) else list(fuzzy)
     for attempt, value in enumerate(ladder):
         try:
-            graph = _partition(norm, box, target_volume, solids, surfaces, value, samples, seed, source, timer)
+            graph = _partition(
+                norm, box, target_volume, solids, surfaces, value, samples, seed, source, timer
+            )
             graph.info.update(info, fuzzy=value, attempts=attempt + 1)
             if check:
                 graph.check(source)
@@ -130,8 +165,18 @@ def build_zone_graph(target, simplify: bool = True, samples: int = 512, seed: in
     return graph
 
 
-def _partition(norm: Normalization, box: np.ndarray, target_volume: float, solids: list, surfaces: list,
-               fuzzy: float, samples: int, seed: int, source: str, timer: _Timer) -> ZoneGraph:
+def _partition(
+    norm: Normalization,
+    box: np.ndarray,
+    target_volume: float,
+    solids: list,
+    surfaces: list,
+    fuzzy: float,
+    samples: int,
+    seed: int,
+    source: str,
+    timer: _Timer,
+) -> ZoneGraph:
     box_solid = BRepPrimAPI_MakeBox(pnt(box[:3]), pnt(box[3:])).Solid()
     builder = _fuse(box_solid, surfaces, fuzzy, source)
     timer.lap("fuse_s")
@@ -143,12 +188,25 @@ def _partition(norm: Normalization, box: np.ndarray, target_volume: float, solid
     points, normals = mesh.samples(samples, np.random.default_rng(seed))
     timer.lap("zones_s")
     graph = ZoneGraph(
-        normalization=norm, box=box, target_volume=target_volume,
-        zone_volume=topo.zone_volume, zone_centroid=topo.zone_centroid, zone_bbox=mesh.zone_bbox(),
-        zone_interior=interior, zone_inside=inside, zone_points=points, zone_normals=normals,
-        face_zones=topo.face_zones, face_area=topo.face_area, face_centroid=topo.face_centroid,
-        face_normal=topo.face_normals(interior), face_surface=topo.face_surface, face_links=topo.face_links(),
-        **_surface_arrays(surfaces), plane_side=mesh.plane_sides(surfaces), solids=topo.zones,
+        normalization=norm,
+        box=box,
+        target_volume=target_volume,
+        zone_volume=topo.zone_volume,
+        zone_centroid=topo.zone_centroid,
+        zone_bbox=mesh.zone_bbox(),
+        zone_interior=interior,
+        zone_inside=inside,
+        zone_points=points,
+        zone_normals=normals,
+        face_zones=topo.face_zones,
+        face_area=topo.face_area,
+        face_centroid=topo.face_centroid,
+        face_normal=topo.face_normals(interior),
+        face_surface=topo.face_surface,
+        face_links=topo.face_links(),
+        **_surface_arrays(surfaces),
+        plane_side=mesh.plane_sides(surfaces),
+        solids=topo.zones,
     )
     timer.lap("graph_s")
     return graph
@@ -160,7 +218,9 @@ def _partition(norm: Normalization, box: np.ndarray, target_volume: float, solid
 class _Topology:
     """Zones, partition faces and which surface each face lies on, from the fuse result."""
 
-    def __init__(self, builder: BOPAlgo_Builder | _Unsplit, box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface]):
+    def __init__(
+        self, builder: BOPAlgo_Builder | _Unsplit, box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface]
+    ):
         result = builder.Shape()
         zone_index = shape_index(result, TopAbs_SOLID)
         self.zones = [TopoDS.Solid(zone_index.FindKey(i)) for i in range(1, zone_index.Size() + 1)]
@@ -181,7 +241,9 @@ class _Topology:
     def _face_zones(self) -> np.ndarray:
         out = np.full((len(self.faces), 2), -1, np.int32)
         for i in range(len(self.faces)):
-            owners = sorted({self.zone_index.FindIndex(s) - 1 for s in shapes_of(self.face_map.FindFromIndex(i + 1))})
+            owners = sorted(
+                {self.zone_index.FindIndex(s) - 1 for s in shapes_of(self.face_map.FindFromIndex(i + 1))}
+            )
             out[i, : len(owners[:2])] = owners[:2]
         return out
 
@@ -212,7 +274,7 @@ class _Topology:
                 return s_idx
         return -1
 
-    def _match_geometry(self, face) -> int:
+    def _match_geometry(self, face: TopoDS_Face) -> int:
         adaptor = BRepAdaptor_Surface(face)
         if adaptor.GetType() == GeomAbs_Plane:
             return self._match_plane(adaptor)
@@ -220,7 +282,11 @@ class _Topology:
             cyl = adaptor.Cylinder()
             d = canonical(xyz(cyl.Axis().Direction()))
             for s_idx, s in enumerate(self.surfaces):
-                if s.kind is SurfaceKind.CYLINDER and parallel(s.axis_dir, d) and abs(s.radius - cyl.Radius()) < 1e-6:
+                if (
+                    s.kind is SurfaceKind.CYLINDER
+                    and parallel(s.axis_dir, d)
+                    and abs(s.radius - cyl.Radius()) < 1e-6
+                ):
                     return s_idx
         return -1
 
@@ -242,7 +308,7 @@ class _Topology:
         for i in range(1, edge_faces.Size() + 1):
             ids = sorted({self.face_map.FindIndex(f) - 1 for f in shapes_of(edge_faces.FindFromIndex(i))})
             for x, a in enumerate(ids):
-                for b in ids[x + 1:]:
+                for b in ids[x + 1 :]:
                     if self.face_surface[a] >= 0 and self.face_surface[a] == self.face_surface[b]:
                         pairs.add((a, b))
         return np.array(sorted(pairs), np.int32).reshape(-1, 2)
@@ -267,7 +333,7 @@ class _ZoneMesh:
         self.face_mesh = [face_triangles(f) for f in topo.faces]
         self.zone_tris = [self._zone_triangles(z) for z in topo.zones]
 
-    def _zone_triangles(self, zone) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _zone_triangles(self, zone: TopoDS_Shape) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Triangle corners (T, 3, 3), outward unit normals (T, 3) and areas (T,) of a zone."""
         corners, normals = [], []
         for face in sub_shapes(zone, TopAbs_FACE):
@@ -312,7 +378,9 @@ class _ZoneMesh:
         return out
 
     @staticmethod
-    def _candidates(centroid, c, n, area, size, tries):
+    def _candidates(
+        centroid: np.ndarray, c: np.ndarray, n: np.ndarray, area: np.ndarray, size: float, tries: int
+    ) -> Iterator[np.ndarray]:
         yield centroid
         for t in np.argsort(-area)[:tries]:
             centre = c[t].mean(axis=0)
@@ -363,15 +431,14 @@ def _classify(points: np.ndarray, solids: Sequence[TopoDS_Shape]) -> np.ndarray:
     return inside
 
 
-def _surface_arrays(surfaces: list[ExtendedSurface]) -> dict[str, np.ndarray]:
-    nan3 = np.full(3, np.nan)
+def _surface_arrays(surfaces: list[ExtendedSurface]) -> dict[str, Any]:
     return {
         "surface_kind": np.array([s.kind.value for s in surfaces], dtype=object),
-        "surface_normal": np.array([s.normal if s.normal is not None else nan3 for s in surfaces]).reshape(-1, 3),
+        "surface_normal": np.array([s.normal for s in surfaces], float).reshape(-1, 3),
         "surface_offset": np.array([s.offset for s in surfaces], float),
-        "surface_axis": np.array([np.concatenate([s.axis_point if s.axis_point is not None else nan3,
-                                                  s.axis_dir if s.axis_dir is not None else nan3])
-                                  for s in surfaces]).reshape(-1, 6),
+        "surface_axis": np.array([np.concatenate([s.axis_point, s.axis_dir]) for s in surfaces]).reshape(
+            -1, 6
+        ),
         "surface_radius": np.array([s.radius for s in surfaces], float),
         "surface_on_box": np.array([s.on_box for s in surfaces], bool),
         "surface_strip": np.array([bool(s.strips) for s in surfaces], bool),

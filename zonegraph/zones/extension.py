@@ -26,8 +26,8 @@ from OCP.gp import gp_Ax3, gp_Cylinder, gp_Pln
 from OCP.TopAbs import TopAbs_FACE, TopAbs_VERTEX
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
-from zonegraph.zones.face_loops import find_face_loops
 from zonegraph.geometry.occ import direction, pnt, shape_index, sub_shapes, surface_props, xyz
+from zonegraph.zones.face_loops import find_face_loops
 
 GEOM_TOL = 1e-7  # normalised units: surfaces closer than this are the same surface
 PARALLEL_TOL = 1e-9  # 1 - |cos| for parallel directions
@@ -49,10 +49,10 @@ class ExtendedSurface:
 
     kind: SurfaceKind
     source_faces: list[int] = field(default_factory=list)
-    normal: np.ndarray | None = None  # planes: unit normal (canonical sign); n . x = offset
+    normal: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))  # planes: n . x = offset
     offset: float = math.nan
-    axis_point: np.ndarray | None = None  # cylinders (closest axis point to the box centre), spheres
-    axis_dir: np.ndarray | None = None
+    axis_point: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))  # nearest the centre
+    axis_dir: np.ndarray = field(default_factory=lambda: np.full(3, np.nan))
     radius: float = math.nan
     on_box: bool = False  # one of the six box faces
     strips: list[tuple[np.ndarray, float, float]] = field(default_factory=list)  # (direction, e0, e1)
@@ -94,7 +94,11 @@ class _Extender:
 
     def plane(self, n: np.ndarray, offset: float, face: int) -> ExtendedSurface:
         for s in self.surfaces:
-            if s.is_plane and parallel(s.normal, n) and abs(s.offset - offset * float(s.normal @ n)) < GEOM_TOL:
+            if (
+                s.is_plane
+                and parallel(s.normal, n)
+                and abs(s.offset - offset * float(s.normal @ n)) < GEOM_TOL
+            ):
                 s.source_faces.append(face)
                 return s
         s = ExtendedSurface(SurfaceKind.PLANE, [face], normal=n, offset=offset)
@@ -104,18 +108,28 @@ class _Extender:
     def cylinder(self, point: np.ndarray, d: np.ndarray, r: float, face: int) -> None:
         p0 = point + d * float((self.centre - point) @ d)
         for s in self.surfaces:
-            if (s.kind is SurfaceKind.CYLINDER and parallel(s.axis_dir, d) and abs(s.radius - r) < GEOM_TOL
-                    and np.linalg.norm(s.axis_point - p0) < GEOM_TOL):
+            if (
+                s.kind is SurfaceKind.CYLINDER
+                and parallel(s.axis_dir, d)
+                and abs(s.radius - r) < GEOM_TOL
+                and np.linalg.norm(s.axis_point - p0) < GEOM_TOL
+            ):
                 s.source_faces.append(face)
                 return
         s = ExtendedSurface(SurfaceKind.CYLINDER, [face], axis_point=p0, axis_dir=d, radius=r)
         ax = gp_Ax3(pnt(p0), direction(d))
-        s.sheets.append(BRepBuilderAPI_MakeFace(gp_Cylinder(ax, r), 0, 2 * math.pi, -self.half, self.half).Face())
+        s.sheets.append(
+            BRepBuilderAPI_MakeFace(gp_Cylinder(ax, r), 0, 2 * math.pi, -self.half, self.half).Face()
+        )
         self.surfaces.append(s)
 
     def sphere(self, centre: np.ndarray, r: float, face: int) -> None:
         for s in self.surfaces:
-            if s.kind is SurfaceKind.SPHERE and abs(s.radius - r) < GEOM_TOL and np.linalg.norm(s.axis_point - centre) < GEOM_TOL:
+            if (
+                s.kind is SurfaceKind.SPHERE
+                and abs(s.radius - r) < GEOM_TOL
+                and np.linalg.norm(s.axis_point - centre) < GEOM_TOL
+            ):
                 s.source_faces.append(face)
                 return
         s = ExtendedSurface(SurfaceKind.SPHERE, [face], axis_point=centre, radius=r)
@@ -128,11 +142,16 @@ class _Extender:
         reach = 2 * self.half
         surface = BRep_Tool.Surface_s(face)
         sheet = BRepBuilderAPI_MakeFace(surface, u0, u1, v0 - reach, v1 + reach, GEOM_TOL).Face()
-        self.surfaces.append(ExtendedSurface(SurfaceKind.EXTRUSION, [index], axis_dir=canonical(xyz(adaptor.Direction())),
-                                             sheets=[sheet]))
+        self.surfaces.append(
+            ExtendedSurface(
+                SurfaceKind.EXTRUSION, [index], axis_dir=canonical(xyz(adaptor.Direction())), sheets=[sheet]
+            )
+        )
 
     def keep_face(self, face: TopoDS_Face, index: int) -> None:
-        self.surfaces.append(ExtendedSurface(SurfaceKind.FACE, [index], sheets=[BRepBuilderAPI_Copy(face).Shape()]))
+        self.surfaces.append(
+            ExtendedSurface(SurfaceKind.FACE, [index], sheets=[BRepBuilderAPI_Copy(face).Shape()])
+        )
 
     # ------------------------------------------------------------------------------ plane sheets
 
@@ -143,7 +162,9 @@ class _Extender:
         value = offset * n[axis]
         return min(abs(value - self.box[axis]), abs(value - self.box[axis + 3])) < GEOM_TOL
 
-    def plane_sheets(self, s: ExtendedSurface, faces: list[TopoDS_Face], loops: dict[int, list[np.ndarray]] | None) -> None:
+    def plane_sheets(
+        self, s: ExtendedSurface, faces: list[TopoDS_Face], loops: dict[int, list[np.ndarray]] | None
+    ) -> None:
         if s.on_box or self.on_box_face(s.normal, s.offset):
             s.on_box = True
             return
@@ -158,11 +179,19 @@ class _Extender:
             pln = gp_Pln(gp_Ax3(pnt(origin), direction(s.normal), direction(d)))
             s.sheets.append(BRepBuilderAPI_MakeFace(pln, -self.half, self.half, e0, e1).Face())
 
-    def _strips(self, s, faces, loops, origin) -> list[tuple[np.ndarray, float, float]]:
+    def _strips(
+        self,
+        s: ExtendedSurface,
+        faces: list[TopoDS_Face],
+        loops: dict[int, list[np.ndarray]],
+        origin: np.ndarray,
+    ) -> list[tuple[np.ndarray, float, float]]:
         """Per loop direction, the union of the walls' extents across it, widened a little."""
         spans: list[tuple[np.ndarray, list[tuple[float, float]]]] = []
         for f in s.source_faces:
-            verts = np.array([xyz(BRep_Tool.Pnt_s(TopoDS.Vertex(v))) for v in sub_shapes(faces[f], TopAbs_VERTEX)])
+            verts = np.array(
+                [xyz(BRep_Tool.Pnt_s(TopoDS.Vertex(v))) for v in sub_shapes(faces[f], TopAbs_VERTEX)]
+            )
             for d in loops[f]:
                 group = next((g for g in spans if parallel(g[0], d)), None)
                 if group is None:
@@ -188,8 +217,9 @@ def _merge(intervals: list[tuple[float, float]]) -> list[tuple[float, float]]:
     return [(a, b) for a, b in out]
 
 
-def extend_faces(target: TopoDS_Shape, box: np.ndarray, simplify: bool = True,
-                 min_area_fraction: float = 1e-7) -> tuple[list[ExtendedSurface], int]:
+def extend_faces(
+    target: TopoDS_Shape, box: np.ndarray, simplify: bool = True, min_area_fraction: float = 1e-7
+) -> tuple[list[ExtendedSurface], int]:
     """Distinct extended surfaces of ``target`` (box planes first) and the number of target faces."""
     faces = [TopoDS.Face(f) for f in _distinct_faces(target)]
     areas = [surface_props(f)[0] for f in faces]
@@ -197,7 +227,7 @@ def extend_faces(target: TopoDS_Shape, box: np.ndarray, simplify: bool = True,
     ext = _Extender(box)
     loops = find_face_loops(faces) if simplify else None
     planes: dict[int, ExtendedSurface] = {}
-    for i, (face, area) in enumerate(zip(faces, areas)):
+    for i, (face, area) in enumerate(zip(faces, areas, strict=False)):
         if area < min_area:
             continue
         adaptor = BRepAdaptor_Surface(face)

@@ -16,14 +16,14 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_Line, GeomAbs_Plane
 from OCP.TopAbs import TopAbs_EDGE
-from OCP.TopoDS import TopoDS, TopoDS_Face
+from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
-from zonegraph.geometry.occ import make_compound, shape_index, sub_shapes, xyz
+from zonegraph.geometry.occ import ShapeIndex, make_compound, shape_index, sub_shapes, xyz
 
 PARALLEL_TOL = 1e-9  # 1 - |cos| between edge directions
 
 
-def _line_direction(edge) -> np.ndarray | None:
+def _line_direction(edge: TopoDS_Shape) -> np.ndarray | None:
     curve = BRepAdaptor_Curve(TopoDS.Edge(edge))
     if curve.GetType() != GeomAbs_Line or BRep_Tool.Degenerated_s(TopoDS.Edge(edge)):
         return None
@@ -50,7 +50,7 @@ def find_face_loops(faces: list[TopoDS_Face]) -> dict[int, list[np.ndarray]]:
         dirs = [_line_direction(e) for e in edges]
         if not _is_wall_candidate(face, dirs):
             continue
-        for e, d in zip(edges, dirs):
+        for e, d in zip(edges, dirs, strict=False):
             if d is None:
                 continue
             eid = all_edges.FindIndex(e)
@@ -71,13 +71,14 @@ def find_face_loops(faces: list[TopoDS_Face]) -> dict[int, list[np.ndarray]]:
             groups.append((d, [eid]))
     loops: dict[int, list[np.ndarray]] = defaultdict(list)
     for d, eids in groups:
-        for component in _cycles([tuple(sorted(set(edge_faces[e]))) for e in eids]):
+        pairs = [(min(edge_faces[e]), max(edge_faces[e])) for e in eids]  # two distinct faces each
+        for component in _cycles(pairs):
             for f in component:
                 loops[f].append(d)
     return dict(loops)
 
 
-def shape_index_of(faces: list[TopoDS_Face]):
+def shape_index_of(faces: list[TopoDS_Face]) -> ShapeIndex:
     """One edge index over all faces, so shared edges get one id."""
     return shape_index(make_compound(faces), TopAbs_EDGE)
 

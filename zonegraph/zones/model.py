@@ -41,8 +41,19 @@ class ZoneGraphBuildError(ZoneGraphError):
         self.status = status.value
 
 
-@dataclass
+@dataclass(repr=False)
 class ZoneGraph:
+    """Zones partitioning the target's box, their faces, links and extended surfaces.
+
+    Everything is in the normalised frame (centred, unit box diagonal; ``normalization`` maps back
+    to the input's units). Faces are the general fuse's partition faces; a face between two zones
+    is a graph edge, one on the box boundary has ``-1`` as its second zone.
+
+    Shapes:
+        Z zones, F partition faces, L face links, S extended surfaces, P samples per zone; the
+        shape of every array is given beside its field.
+    """
+
     normalization: Normalization
     box: np.ndarray  # (6,) normalised AABB of the target
     target_volume: float  # normalised units
@@ -72,6 +83,13 @@ class ZoneGraph:
     plane_side: np.ndarray  # (S, Z) int8: +1/-1 side of each plane, 0 straddles (or not a plane)
     solids: list | None = None  # zone solids (TopoDS_Solid), in zone order
     info: dict = field(default_factory=dict)  # status, simplified, target faces, timings
+
+    def __repr__(self) -> str:
+        simplified = self.info.get("simplified")
+        return (
+            f"ZoneGraph({self.n_zones} zones ({int(self.zone_inside.sum())} inside), {self.n_faces} faces, "
+            f"{len(self.edges)} edges, {self.n_surfaces} surfaces, simplified={simplified})"
+        )
 
     @property
     def n_zones(self) -> int:
@@ -107,14 +125,22 @@ class ZoneGraph:
         """Raise ZoneGraphBuildError unless every invariant of a usable zone graph holds."""
         total = float(self.zone_volume.sum())
         if abs(total - self.box_volume) > BOX_VOLUME_RTOL * self.box_volume:
-            raise ZoneGraphBuildError(BuildStatus.FUSE_FAILED, source,
-                                      f"zone volumes sum to {total / self.box_volume:.9f} of the box")
+            raise ZoneGraphBuildError(
+                BuildStatus.FUSE_FAILED,
+                source,
+                f"zone volumes sum to {total / self.box_volume:.9f} of the box",
+            )
         if abs(self.inside_volume - self.target_volume) > TARGET_VOLUME_RTOL * self.target_volume:
-            raise ZoneGraphBuildError(BuildStatus.TARGET_MISMATCH, source,
-                                      f"inside zones hold {self.inside_volume / self.target_volume:.6f} of the target volume")
+            raise ZoneGraphBuildError(
+                BuildStatus.TARGET_MISMATCH,
+                source,
+                f"inside zones hold {self.inside_volume / self.target_volume:.6f} of the target volume",
+            )
         if not np.isfinite(self.zone_interior).all():
             missing = int((~np.isfinite(self.zone_interior).all(axis=1)).sum())
-            raise ZoneGraphBuildError(BuildStatus.NO_INTERIOR_POINT, source, f"{missing} zones have no interior point")
+            raise ZoneGraphBuildError(
+                BuildStatus.NO_INTERIOR_POINT, source, f"{missing} zones have no interior point"
+            )
         if self.n_zones > 1:
             e = self.edges
             adj = coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(self.n_zones,) * 2)
@@ -123,5 +149,11 @@ class ZoneGraph:
                 raise ZoneGraphBuildError(BuildStatus.DISCONNECTED, source, f"zone graph has {n} components")
 
     def summary(self) -> dict:
-        return {"zones": self.n_zones, "faces": self.n_faces, "edges": len(self.edges),
-                "surfaces": self.n_surfaces, "inside_zones": int(self.zone_inside.sum()), **self.info}
+        return {
+            "zones": self.n_zones,
+            "faces": self.n_faces,
+            "edges": len(self.edges),
+            "surfaces": self.n_surfaces,
+            "inside_zones": int(self.zone_inside.sum()),
+            **self.info,
+        }

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
+from numpy.typing import DTypeLike
 from OCP.BRep import BRep_Builder
 from OCP.BRepTools import BRepTools
 from OCP.TopAbs import TopAbs_SOLID
@@ -28,13 +29,13 @@ from zonegraph.zones.model import ZoneGraph
 META_KEY = b"zonegraph"
 
 
-def _fixed(arr: np.ndarray, dtype=None) -> pa.FixedSizeListArray:
+def _fixed(arr: np.ndarray, dtype: DTypeLike | None = None) -> pa.FixedSizeListArray:
     arr = np.asarray(arr, dtype=dtype)
     width = int(np.prod(arr.shape[1:])) if arr.ndim > 1 else 1
     return pa.FixedSizeListArray.from_arrays(pa.array(arr.reshape(-1)), width)
 
 
-def _unfixed(column: pa.ChunkedArray, shape: tuple[int, ...], dtype=float) -> np.ndarray:
+def _unfixed(column: pa.ChunkedArray, shape: tuple[int, ...], dtype: DTypeLike = float) -> np.ndarray:
     flat = column.combine_chunks().flatten().to_numpy(zero_copy_only=False)
     return flat.astype(dtype).reshape((len(column),) + shape)
 
@@ -42,29 +43,66 @@ def _unfixed(column: pa.ChunkedArray, shape: tuple[int, ...], dtype=float) -> np
 def save_zone_graph(graph: ZoneGraph, folder: str | Path) -> Path:
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    meta = {"center": graph.normalization.center, "scale": graph.normalization.scale,
-            "box": graph.box.tolist(), "target_volume": graph.target_volume, "info": graph.info,
-            "samples": int(graph.zone_points.shape[1])}
-    zones = pa.table({
-        "volume": graph.zone_volume, "centroid": _fixed(graph.zone_centroid), "bbox": _fixed(graph.zone_bbox),
-        "interior": _fixed(graph.zone_interior), "inside": graph.zone_inside,
-    }).replace_schema_metadata({META_KEY: json.dumps(meta)})
+    meta = {
+        "center": graph.normalization.center,
+        "scale": graph.normalization.scale,
+        "box": graph.box.tolist(),
+        "target_volume": graph.target_volume,
+        "info": graph.info,
+        "samples": int(graph.zone_points.shape[1]),
+    }
+    zones = pa.table(
+        {
+            "volume": graph.zone_volume,
+            "centroid": _fixed(graph.zone_centroid),
+            "bbox": _fixed(graph.zone_bbox),
+            "interior": _fixed(graph.zone_interior),
+            "inside": graph.zone_inside,
+        }
+    ).replace_schema_metadata({META_KEY: json.dumps(meta)})
     pq.write_table(zones, folder / "zones.parquet")
-    pq.write_table(pa.table({
-        "zone_a": graph.face_zones[:, 0], "zone_b": graph.face_zones[:, 1], "area": graph.face_area,
-        "centroid": _fixed(graph.face_centroid), "normal": _fixed(graph.face_normal), "surface": graph.face_surface,
-    }), folder / "faces.parquet")
-    pq.write_table(pa.table({"face_a": graph.face_links[:, 0], "face_b": graph.face_links[:, 1]}),
-                   folder / "links.parquet")
-    pq.write_table(pa.table({
-        "kind": pa.array(list(graph.surface_kind), pa.string()), "normal": _fixed(graph.surface_normal),
-        "offset": graph.surface_offset, "axis": _fixed(graph.surface_axis), "radius": graph.surface_radius,
-        "on_box": graph.surface_on_box, "strip": graph.surface_strip,
-        "plane_side": _fixed(graph.plane_side.reshape(graph.n_surfaces, -1), np.int8),
-    }), folder / "surfaces.parquet")
-    pq.write_table(pa.table({"points": _fixed(graph.zone_points, np.float16),
-                             "normals": _fixed(graph.zone_normals, np.float16)}),
-                   folder / "samples.parquet", compression="zstd")
+    pq.write_table(
+        pa.table(
+            {
+                "zone_a": graph.face_zones[:, 0],
+                "zone_b": graph.face_zones[:, 1],
+                "area": graph.face_area,
+                "centroid": _fixed(graph.face_centroid),
+                "normal": _fixed(graph.face_normal),
+                "surface": graph.face_surface,
+            }
+        ),
+        folder / "faces.parquet",
+    )
+    pq.write_table(
+        pa.table({"face_a": graph.face_links[:, 0], "face_b": graph.face_links[:, 1]}),
+        folder / "links.parquet",
+    )
+    pq.write_table(
+        pa.table(
+            {
+                "kind": pa.array(list(graph.surface_kind), pa.string()),
+                "normal": _fixed(graph.surface_normal),
+                "offset": graph.surface_offset,
+                "axis": _fixed(graph.surface_axis),
+                "radius": graph.surface_radius,
+                "on_box": graph.surface_on_box,
+                "strip": graph.surface_strip,
+                "plane_side": _fixed(graph.plane_side.reshape(graph.n_surfaces, -1), np.int8),
+            }
+        ),
+        folder / "surfaces.parquet",
+    )
+    pq.write_table(
+        pa.table(
+            {
+                "points": _fixed(graph.zone_points, np.float16),
+                "normals": _fixed(graph.zone_normals, np.float16),
+            }
+        ),
+        folder / "samples.parquet",
+        compression="zstd",
+    )
     if graph.solids is not None:
         BRepTools.Write_s(make_compound(graph.solids), str(folder / "zones.brep"))
     return folder
@@ -82,20 +120,31 @@ def load_zone_graph(folder: str | Path, solids: bool = True) -> ZoneGraph:
     samples = pq.read_table(folder / "samples.parquet")
     n_zones, n_samples = zones.num_rows, meta["samples"]
     return ZoneGraph(
-        normalization=Normalization(tuple(meta["center"]), meta["scale"]), box=np.array(meta["box"]),
+        normalization=Normalization(tuple(meta["center"]), meta["scale"]),
+        box=np.array(meta["box"]),
         target_volume=meta["target_volume"],
-        zone_volume=zones["volume"].to_numpy(), zone_centroid=_unfixed(zones["centroid"], (3,)),
-        zone_bbox=_unfixed(zones["bbox"], (6,)), zone_interior=_unfixed(zones["interior"], (3,)),
+        zone_volume=zones["volume"].to_numpy(),
+        zone_centroid=_unfixed(zones["centroid"], (3,)),
+        zone_bbox=_unfixed(zones["bbox"], (6,)),
+        zone_interior=_unfixed(zones["interior"], (3,)),
         zone_inside=zones["inside"].to_numpy(zero_copy_only=False),
         zone_points=_unfixed(samples["points"], (n_samples, 3), np.float32),
         zone_normals=_unfixed(samples["normals"], (n_samples, 3), np.float32),
-        face_zones=np.stack([faces["zone_a"].to_numpy(), faces["zone_b"].to_numpy()], axis=1).astype(np.int32),
-        face_area=faces["area"].to_numpy(), face_centroid=_unfixed(faces["centroid"], (3,)),
-        face_normal=_unfixed(faces["normal"], (3,)), face_surface=faces["surface"].to_numpy().astype(np.int32),
-        face_links=np.stack([links["face_a"].to_numpy(), links["face_b"].to_numpy()], axis=1).astype(np.int32),
+        face_zones=np.stack([faces["zone_a"].to_numpy(), faces["zone_b"].to_numpy()], axis=1).astype(
+            np.int32
+        ),
+        face_area=faces["area"].to_numpy(),
+        face_centroid=_unfixed(faces["centroid"], (3,)),
+        face_normal=_unfixed(faces["normal"], (3,)),
+        face_surface=faces["surface"].to_numpy().astype(np.int32),
+        face_links=np.stack([links["face_a"].to_numpy(), links["face_b"].to_numpy()], axis=1).astype(
+            np.int32
+        ),
         surface_kind=np.array(surfaces["kind"].to_pylist(), dtype=object),
-        surface_normal=_unfixed(surfaces["normal"], (3,)), surface_offset=surfaces["offset"].to_numpy(),
-        surface_axis=_unfixed(surfaces["axis"], (6,)), surface_radius=surfaces["radius"].to_numpy(),
+        surface_normal=_unfixed(surfaces["normal"], (3,)),
+        surface_offset=surfaces["offset"].to_numpy(),
+        surface_axis=_unfixed(surfaces["axis"], (6,)),
+        surface_radius=surfaces["radius"].to_numpy(),
         surface_on_box=surfaces["on_box"].to_numpy(zero_copy_only=False),
         surface_strip=surfaces["strip"].to_numpy(zero_copy_only=False),
         plane_side=_unfixed(surfaces["plane_side"], (n_zones,), np.int8),
