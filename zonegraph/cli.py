@@ -52,7 +52,7 @@ def _cmd_build(args: argparse.Namespace) -> int:
     from zonegraph.jobs import build_and_save
 
     config = BuildConfig(simplify=not args.no_simplify, samples=args.samples, seed=args.seed)
-    outcome = run_isolated(build_and_save, (args.target, args.out, config), timeout=args.timeout)
+    outcome = run_isolated(build_and_save, (args.target, args.out, config, True), timeout=args.timeout)
     if not outcome.ok:
         print(f"zonegraph: error: {args.target}: {outcome.status}: {outcome.reason}", file=sys.stderr)
         return EXIT_USER_ERROR
@@ -99,7 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_replay)
     p = sub.add_parser("build", help="build the zone graph of a STEP/BREP part or a design JSON")
     p.add_argument("target", help="PART.step, PART.brep or DESIGN.json")
-    p.add_argument("--out", required=True, help="output folder (Parquet tables and zones.brep)")
+    p.add_argument("--out", required=True, help="output folder (Parquet tables, zones.brep, zones.ply)")
     p.add_argument("--no-simplify", action="store_true", help="extend face-loop walls as full planes")
     b = BuildConfig.defaults()
     p.add_argument("--samples", type=int, default=b["samples"], help="surface samples per zone")

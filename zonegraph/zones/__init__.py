@@ -8,6 +8,7 @@ Imports only :mod:`zonegraph.geometry` and :mod:`zonegraph.errors`.
 
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import BuildStatus, ZoneGraph, ZoneGraphBuildError
+from zonegraph.zones.sampling import export_zone_mesh, sample_zone_surfaces
 from zonegraph.zones.storage import load_zone_graph, save_zone_graph
 
 __all__ = [
@@ -15,6 +16,8 @@ __all__ = [
     "ZoneGraph",
     "ZoneGraphBuildError",
     "build_zone_graph",
+    "export_zone_mesh",
     "load_zone_graph",
+    "sample_zone_surfaces",
     "save_zone_graph",
 ]

@@ -42,6 +42,7 @@ from zonegraph.geometry.occ import (
 )
 from zonegraph.zones.extension import ExtendedSurface, SurfaceKind, canonical, extend_faces, parallel
 from zonegraph.zones.model import BuildStatus, ZoneGraph, ZoneGraphBuildError
+from zonegraph.zones.sampling import sample_zone_surfaces
 
 # Fuzzy values of the general fuse, in normalised units, tried in turn: 1e-7..1e-5 leave zone counts
 # unchanged where the fuse works at all, 1e-3 loses zones.
@@ -185,7 +186,7 @@ def _partition(
     mesh = _ZoneMesh(topo)
     interior = mesh.interior_points()
     inside = _classify(interior, solids)
-    points, normals = mesh.samples(samples, np.random.default_rng(seed))
+    points, normals = sample_zone_surfaces(mesh.zone_tris, samples, np.random.default_rng(seed))
     timer.lap("zones_s")
     graph = ZoneGraph(
         normalization=norm,
@@ -386,19 +387,6 @@ class _ZoneMesh:
             centre = c[t].mean(axis=0)
             for step in (1e-2, 1e-3, 1e-4, 1e-5):
                 yield centre - step * size * n[t]
-
-    def samples(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        points = np.zeros((len(self.zone_tris), count, 3), np.float32)
-        normals = np.zeros_like(points)
-        for z, (c, n, area) in enumerate(self.zone_tris):
-            if not len(area) or count == 0:
-                continue
-            t = rng.choice(len(area), size=count, p=area / area.sum())
-            r1, r2 = np.sqrt(rng.random(count)), rng.random(count)
-            w = np.stack([1 - r1, r1 * (1 - r2), r1 * r2], axis=1)
-            points[z] = np.einsum("pk,pkd->pd", w, c[t])
-            normals[z] = n[t]
-        return points, normals
 
     def plane_sides(self, surfaces: list[ExtendedSurface]) -> np.ndarray:
         """(S, Z): which side of each plane every zone lies on (from all its mesh nodes)."""
