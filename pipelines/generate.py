@@ -1,21 +1,29 @@
-"""DVC stage ``generate``: the design index (and, by default, the synthetic designs themselves).
+"""DVC stage ``generate``: the design index, from one of three sources (``params.yaml: data``).
 
-With ``data.fusion_dir`` set, the stage indexes that folder (the r1.0.1 reconstruction data or any
-folder of design JSONs) and copies nothing. Otherwise it generates ``synthetic.count`` seeded
-designs in parallel. Either way it writes ``data/designs/index.parquet`` (design id, path, split)
-and ``stats.json``/``stats.txt`` comparing the designs with the published statistics.
+- ``synthetic`` (the offline default): ``synthetic.count`` seeded designs generated in parallel;
+- ``fusion_json``: a folder of Fusion 360 Gallery reconstruction JSON (r1.0.1), indexed in place;
+- ``b123d``: the build123d corpus (a clone of Fusion360GalleryDataset-build123d): each design's
+  script is run, its extrudes converted to our JSON and verified against the script's part and
+  Fusion's volume (``zonegraph.data.b123d``), one killable Dask task per design, resumable.
+
+``data.limit`` keeps a seeded sample, stratified by timeline folder. Either way the stage writes
+``data/designs/index.parquet`` (design id, path, split, folder: the timeline-length bucket),
+``stats.json``/``stats.txt`` beside the published statistics and, for the corpus,
+``conversion.parquet`` (every design with its status and reason) and ``data/metrics/conversion.json``.
 """
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
-from zonegraph.data.dataset import read_dataset
+from zonegraph.data.b123d import convert_design, list_corpus
+from zonegraph.data.dataset import DesignRecord, read_dataset, stratified_sample, test_ids
 from zonegraph.data.design import load_design
-from zonegraph.data.stats import design_statistics, format_comparison
+from zonegraph.data.stats import design_statistics, format_comparison, timeline_folder
 from zonegraph.data.synthetic import design_seed, generate_design, synthetic_id
 
 from .cluster import dask_client
@@ -23,13 +31,32 @@ from .params import load_params
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/designs")
+METRICS = Path("data/metrics/conversion.json")
 
 
-def write_design(design_id: str, seed: int, path: str) -> dict:
+def write_design(design_id: str, seed: int, path: str) -> dict[str, Any]:
     """Job body: one synthetic design written to ``path``."""
     data = generate_design(design_id, seed)
     Path(path).write_text(json.dumps(data))
     return {"extrudes": sum(e["type"] == "ExtrudeFeature" for e in data["entities"].values())}
+
+
+def convert_to_json(batch: str, design_id: str, path: str, timeout_s: float) -> dict[str, Any]:
+    """Job body: one corpus design converted and verified; its JSON written when it is ok."""
+    result = convert_design(batch, design_id, timeout_s=timeout_s)
+    if result.ok and result.design_json is not None:
+        Path(path).write_text(json.dumps(result.design_json))
+    return {
+        "convert_status": result.status,
+        "convert_reason": result.reason,
+        "folder": result.folder,
+        "steps": result.steps,
+        "operations": ",".join(result.operations),
+        "mode_disagreements": result.mode_disagreements,
+        "volume_rel_error": result.volume_rel_error,
+        "area_rel_error": result.area_rel_error,
+        "fusion_volume_rel_error": result.fusion_volume_rel_error,
+    }
 
 
 def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
@@ -42,37 +69,131 @@ def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
         jobs.append(Job(name, fingerprint(code, s), (name, s, str(json_dir / f"{name}.json"))))
     with dask_client(dask_cfg) as client:
         records = run_jobs(write_design, jobs, OUT / "records", client, timeout, "generate")
-    failed = [r for r in records if r["status"] != "ok"]
-    for r in failed:
-        print(f"generate: {r['design_id']} failed ({r['status']}): {r['reason']}")
-        (json_dir / f"{r['design_id']}.json").unlink(missing_ok=True)
+    for r in records:
+        if r["status"] != "ok":
+            print(f"generate: {r['design_id']} failed ({r['status']}): {r['reason']}")
+            (json_dir / f"{r['design_id']}.json").unlink(missing_ok=True)
     return json_dir
+
+
+def convert_corpus(root: Path, limit: int | None, seed: int, dask_cfg: dict, timeout: float) -> pd.DataFrame:
+    """Convert (a stratified sample of) the corpus; returns one row per design, failures included."""
+    entries = list_corpus(root)
+    entries = [entries[i] for i in stratified_sample([e.folder for e in entries], limit, seed)]
+    json_dir = OUT / "json"
+    json_dir.mkdir(parents=True, exist_ok=True)
+    code = code_fingerprint("generate")
+    jobs = [
+        Job(
+            e.design_id,
+            fingerprint(code, timeout, files=(e.batch,)),
+            (e.batch, e.design_id, str(json_dir / f"{e.design_id}.json"), timeout),
+        )
+        for e in entries
+    ]
+    with dask_client(dask_cfg) as client:  # the child's own alarm fires first; the kill is the backstop
+        records = run_jobs(convert_to_json, jobs, OUT / "convert_records", client, timeout + 30, "convert")
+    table = pd.DataFrame(records).drop(columns=["fingerprint"])
+    table["folder"] = [e.folder for e in entries]
+    failed = table["status"] != "ok"  # the child itself timed out or crashed
+    table.loc[failed, "convert_status"] = table.loc[failed, "status"]
+    table.loc[failed, "convert_reason"] = table.loc[failed, "reason"]
+    for row in table.itertuples():
+        if row.convert_status != "ok":
+            (json_dir / f"{row.design_id}.json").unlink(missing_ok=True)
+    return table.drop(columns=["status", "reason"]).rename(
+        columns={"convert_status": "status", "convert_reason": "reason"}
+    )
+
+
+def write_conversion(table: pd.DataFrame) -> None:
+    table.to_parquet(OUT / "conversion.parquet", index=False)
+    ok = table["status"] == "ok"
+    metrics = {
+        "source": "b123d",
+        "designs": int(len(table)),
+        "converted": int(ok.sum()),
+        "rate": float(ok.mean()) if len(table) else 0.0,
+        "by_status": {k: int(v) for k, v in table["status"].value_counts().items()},
+        "by_folder": {
+            f: {"designs": int(len(g)), "converted": int((g["status"] == "ok").sum())}
+            for f, g in table.groupby("folder")
+        },
+        "median_seconds": float(table["seconds"].median()) if len(table) else None,
+    }
+    METRICS.parent.mkdir(parents=True, exist_ok=True)
+    METRICS.write_text(json.dumps(metrics, indent=2))
+    print(
+        f"convert: {metrics['converted']}/{metrics['designs']} converted and verified "
+        f"({metrics['rate']:.2%}), by status {metrics['by_status']}"
+    )
 
 
 def main() -> None:
     params = load_params()
     data = params["data"]
-    if data.get("fusion_dir"):
-        folder = Path(data["fusion_dir"]).expanduser().resolve()
-    else:
+    source = data.get("source", "synthetic")
+    limit = data.get("limit")
+    seed, fraction = int(data["split_seed"]), float(data["test_fraction"])
+    if source == "fusion_json":
+        folder = Path(data["fusion_json_dir"]).expanduser().resolve()
+    elif source == "b123d":
+        root = Path(data["b123d_dir"]).expanduser().resolve()
+        table = convert_corpus(
+            root,
+            limit,
+            int(data.get("limit_seed", 0)),
+            params["dask"],
+            float(data.get("convert_timeout_s", 120)),
+        )
+        write_conversion(table)
+        folder = OUT / "json"
+    elif source == "synthetic":
         syn = params["synthetic"]
         folder = generate(int(syn["count"]), int(syn["seed"]), params["dask"], float(syn["timeout_s"]))
-    records = read_dataset(folder, seed=int(data["split_seed"]), test_fraction=float(data["test_fraction"]))
-    OUT.mkdir(parents=True, exist_ok=True)
-    pd.DataFrame(
-        [{"design_id": r.design_id, "path": str(r.path), "split": r.split} for r in records]
-    ).to_parquet(OUT / "index.parquet", index=False)
-    designs = []
+    else:
+        raise SystemExit(f"generate: unknown data.source {source!r} (synthetic, fusion_json or b123d)")
+    if source == "b123d":  # this run's converted designs (the folder may hold earlier runs' too)
+        ids = sorted(table.loc[table["status"] == "ok", "design_id"])
+        test = test_ids(ids, seed, fraction)
+        records = [DesignRecord(i, folder / f"{i}.json", "test" if i in test else "train") for i in ids]
+    else:
+        records = read_dataset(folder, seed=seed, test_fraction=fraction)
+    if source == "fusion_json" and limit is not None:
+        records = [records[i] for i in stratified_sample(["all"] * len(records), limit, seed)]
+    write_index(records, table if source == "b123d" else None)
+    if source != "b123d":  # nothing converted: the metric says so
+        METRICS.parent.mkdir(parents=True, exist_ok=True)
+        METRICS.write_text(json.dumps({"source": source, "designs": len(records)}, indent=2))
+    print(f"generate: {len(records)} designs from {folder} ({source})")
+
+
+def write_index(records: list[DesignRecord], table: pd.DataFrame | None) -> None:
+    designs, folders = [], []
     for r in records:
         try:
-            designs.append(load_design(r.path))
+            design = load_design(r.path)
         except Exception:  # unreadable designs are reported by the replay stage
+            folders.append("unreadable")
             continue
+        designs.append(design)
+        folders.append(timeline_folder(len(design.timeline)))
+    index = pd.DataFrame(
+        {
+            "design_id": [r.design_id for r in records],
+            "path": [str(r.path) for r in records],
+            "split": [r.split for r in records],
+            "folder": folders,
+        }
+    )
+    if table is not None:  # the corpus's own timeline folders
+        index["folder"] = index["design_id"].map(table.set_index("design_id")["folder"])
+    OUT.mkdir(parents=True, exist_ok=True)
+    index.to_parquet(OUT / "index.parquet", index=False)
     stats = design_statistics(designs)
     (OUT / "stats.json").write_text(json.dumps(stats, indent=2))
     (OUT / "stats.txt").write_text(format_comparison(stats) + "\n")
-    splits = pd.Series([r.split for r in records]).value_counts().to_dict()
-    print(f"generate: {len(records)} designs from {folder} ({splits})")
+    print(f"generate: splits {index['split'].value_counts().to_dict()}")
 
 
 if __name__ == "__main__":

@@ -6,11 +6,18 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from zonegraph.configs import BuildConfig
 from zonegraph.data.targets import load_target
+from zonegraph.geometry.shapes import read_shape, read_solids
+from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.sequence.ground_truth import ground_truth
+from zonegraph.sequence.rankers import HeuristicRanker
 from zonegraph.zones.build import build_zone_graph
+from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.sampling import export_zone_mesh
-from zonegraph.zones.storage import save_zone_graph
+from zonegraph.zones.storage import load_zone_graph, save_zone_graph
 
 
 def build_and_save(
@@ -31,3 +38,73 @@ def build_and_save(
     if mesh:
         export_zone_mesh(graph, Path(out) / "zones.ply")
     return graph.summary()
+
+
+def ground_truth_and_coverage(
+    brep_dir: str,
+    graph_dir: str,
+    operations: list[str],
+    levels: tuple[int, ...] = (1, 3),
+    search_budget_s: float = 2.0,
+    full_graph: bool = True,
+) -> dict[str, Any]:
+    """A design's ground truth on its saved (simplified) zone graph, and on the full graph.
+
+    Args:
+        brep_dir: the replay stage's folder: ``final.brep`` and ``NN_tool.brep`` (design units).
+        graph_dir: the zonegraphs stage's saved graph of ``final.brep``.
+        operations: Fusion's operation of each extrude, in timeline order.
+        levels: proposal levels at which capture is tested.
+        search_budget_s: heuristic search budget for a graph whose GT is not captured at level 1
+            (does another sequence reach the target?).
+        full_graph: also build the unsimplified graph when simplification changed it.
+
+    Returns:
+        Plain data: ``steps`` (one dict per GT step and graph) and per-graph design fields.
+    """
+    tools = [read_shape(Path(brep_dir) / f"{i:02d}_tool.brep").wrapped for i in range(len(operations))]
+    graph = load_zone_graph(graph_dir)
+    out: dict[str, Any] = {"steps": []}
+    variants: list[tuple[str, ZoneGraph]] = [
+        ("simplified" if graph.info.get("simplified") else "full", graph)
+    ]
+    if full_graph and graph.info.get("simplified"):
+        if graph.surface_strip.any():
+            solids = read_solids(Path(brep_dir) / "final.brep")
+            try:
+                variants.append(
+                    ("full", build_zone_graph(solids, simplify=False, samples=0, source=brep_dir))
+                )
+            except ZoneGraphBuildError as exc:
+                out["full_status"], out["full_reason"] = exc.status, exc.reason
+        else:  # no face loop: the full graph is this graph
+            variants.append(("full", graph))
+    for name, g in variants:
+        gt = ground_truth(g, tools, operations, levels)
+        exact = None
+        if not gt.captured(1):
+            result = search(g, HeuristicRanker(), SearchConfig(budget_s=search_budget_s))
+            exact = result.exact
+        out[f"{name}_status"] = "ok"
+        out[f"{name}_zones"] = g.n_zones
+        out[f"{name}_reaches_target"] = gt.reaches_target
+        for level in levels:
+            out[f"{name}_captured_l{level}"] = gt.captured(level)
+        out[f"{name}_search_exact"] = exact
+        out[f"{name}_reason"] = gt.reason or next((s.reason for s in gt.steps if s.reason), "")
+        for s in gt.steps:
+            out["steps"].append(
+                {
+                    "graph": name,
+                    "step": s.index,
+                    "operation": s.operation,
+                    "gt_zones": np.flatnonzero(s.zones).astype(int).tolist(),
+                    "mapping_error": s.mapping_error,
+                    "mapped": s.mapped,
+                    **{f"captured_l{k}": v for k, v in s.captured.items()},
+                    **{f"effect_captured_l{k}": v for k, v in s.effect_captured.items()},
+                    **{f"proposals_l{k}": v for k, v in s.proposals.items()},
+                    "reason": s.reason,
+                }
+            )
+    return out

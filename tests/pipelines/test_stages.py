@@ -19,7 +19,12 @@ def run_stage(module: str, cwd) -> str:
 
 def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):
     params = {
-        "data": {"fusion_dir": str(samples_dir), "split_seed": 0, "test_fraction": 0.2},
+        "data": {
+            "source": "fusion_json",
+            "fusion_json_dir": str(samples_dir),
+            "split_seed": 0,
+            "test_fraction": 0.2,
+        },
         "synthetic": {"count": 0, "seed": 0, "timeout_s": 60},
         "dask": {"scheduler": None, "n_workers": 2},
         "replay": {"timeout_s": 60},

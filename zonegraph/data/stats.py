@@ -24,6 +24,18 @@ PUBLISHED = {
 BASIC_CURVES = {"Line", "Arc", "Circle"}
 
 
+TIMELINE_FOLDERS = ((2, "01_2ops"), (3, "02_3ops"), (5, "03_4to5ops"), (7, "04_6to7ops"), (10, "05_8to10ops"),
+                    (15, "06_11to15ops"), (20, "07_16to20ops"))
+
+
+def timeline_folder(length: int) -> str:
+    """The corpus's timeline folder for a timeline of ``length`` entities (sketches + extrudes)."""
+    for most, name in TIMELINE_FOLDERS:
+        if length <= most:
+            return name
+    return "08_21plus"
+
+
 def design_statistics(designs: Iterable[Design]) -> dict:
     designs = list(designs)
     lengths = np.array([len(d.timeline) for d in designs])

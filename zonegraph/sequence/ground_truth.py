@@ -128,7 +128,9 @@ def ground_truth(
         steps.append(step)
         canvas = after
     reaches = bool(np.array_equal(canvas, graph.zone_inside))
-    reason = "" if reaches else f"GT replay on zones ends {int((canvas != graph.zone_inside).sum())} zones off"
+    reason = (
+        "" if reaches else f"GT replay on zones ends {int((canvas != graph.zone_inside).sum())} zones off"
+    )
     return GroundTruth(steps, reaches, reason)
 
 

@@ -1,0 +1,122 @@
+"""DVC stage ``ground_truth``: every design's GT sequence on its zone graphs, and the coverage.
+
+For each design whose zone graph was built, the replay's tool bodies are mapped onto the saved
+(simplified) graph and onto the full graph, replayed on zones, and each step is tested for capture
+at proposal levels 1 and 3 (``zonegraph.sequence.ground_truth``); a design whose GT is not
+captured gets a heuristic search (``ground_truth.search_budget_s``) to tell "another sequence"
+from "not reconstructed". Outputs: ``data/gt/steps.parquet`` (design, graph, step, operation, GT
+zone ids, captured and proposal count at each level, mapping check, reason),
+``data/gt/designs.parquet`` (one row per design of the run, failures of earlier stages included),
+``data/gt/coverage.md``, ``data/plots/coverage.png`` and ``data/metrics/coverage.json``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from eval.coverage import CATEGORIES, coverage_table, plot_coverage, to_markdown
+from zonegraph.jobs import ground_truth_and_coverage
+
+from .cluster import dask_client
+from .params import load_params
+from .runner import Job, code_fingerprint, fingerprint, run_jobs
+
+OUT = Path("data/gt")
+PLOTS = Path("data/plots")
+METRICS = Path("data/metrics/coverage.json")
+
+
+def designs_table() -> pd.DataFrame:
+    """Every design of the run with the status of each earlier stage (conversion when present)."""
+    index = pd.read_parquet("data/designs/index.parquet")[["design_id", "split", "folder"]]
+    replay = pd.read_parquet("data/replay/manifest.parquet")
+    replay = replay[["design_id", "status", "error", "steps", "operations", "brep_dir"]]
+    replay = replay.rename(columns={"status": "replay_status", "error": "replay_reason"})
+    graphs = pd.read_parquet("data/zonegraphs/manifest.parquet")[["design_id", "status", "reason", "zones"]]
+    graphs = graphs.rename(
+        columns={"status": "graph_status", "reason": "graph_reason", "zones": "graph_zones"}
+    )
+    table = index.merge(replay, on="design_id", how="left").merge(graphs, on="design_id", how="left")
+    conversion = Path("data/designs/conversion.parquet")
+    if conversion.is_file():  # corpus runs: designs that never became JSON count too
+        conv = pd.read_parquet(conversion)[["design_id", "folder", "status", "reason"]]
+        conv = conv.rename(columns={"status": "convert_status", "reason": "convert_reason"})
+        failed = conv[conv["convert_status"] != "ok"].assign(split="none")
+        table = pd.concat([table.assign(convert_status="ok", convert_reason=""), failed], ignore_index=True)
+    return table
+
+
+def main() -> None:
+    params = load_params()
+    cfg = params["ground_truth"]
+    levels = tuple(int(k) for k in cfg["levels"])
+    table = designs_table()
+    todo = table[table["graph_status"] == "ok"]
+    code = code_fingerprint("ground_truth")
+    settings = (levels, float(cfg["search_budget_s"]), bool(cfg["full_graph"]))
+    jobs = []
+    for row in todo.itertuples():
+        graph = Path("data/zonegraphs/graphs") / row.design_id
+        ops = row.operations.split(",")
+        jobs.append(
+            Job(
+                row.design_id,
+                fingerprint(code, settings, ops, files=(row.brep_dir, graph)),
+                (row.brep_dir, str(graph), ops, *settings),
+                cost=float(row.graph_zones),
+            )
+        )
+    with dask_client(params["dask"]) as client:
+        records = run_jobs(
+            ground_truth_and_coverage, jobs, OUT / "records", client, float(cfg["timeout_s"]), "ground_truth"
+        )
+    steps = [dict(step, design_id=r["design_id"]) for r in records for step in r.get("steps", [])]
+    OUT.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame(steps).to_parquet(OUT / "steps.parquet", index=False)
+    results = pd.DataFrame([{k: v for k, v in r.items() if k != "steps"} for r in records])
+    failed = results["status"] != "ok"  # the whole job timed out or crashed
+    for graph in ("simplified", "full"):
+        column = f"{graph}_status"
+        if column not in results:
+            results[column] = None
+        results.loc[failed, column] = results.loc[failed, "status"]
+    results = results.drop(columns=["status", "reason", "fingerprint"]).rename(
+        columns={"seconds": "gt_seconds"}
+    )
+    designs = table.merge(results, on="design_id", how="left")
+    designs.to_parquet(OUT / "designs.parquet", index=False)
+    write_coverage(designs, levels)
+
+
+def write_coverage(designs: pd.DataFrame, levels: tuple[int, ...]) -> None:
+    variants = {
+        f"{graph} graph, level {level}": (graph, level)
+        for graph in ("simplified", "full")
+        for level in levels
+    }
+    tables = {name: coverage_table(designs, graph, level) for name, (graph, level) in variants.items()}
+    (OUT / "coverage.md").write_text(to_markdown(tables))
+    first = next(iter(tables))
+    plot_coverage(tables[first], PLOTS / "coverage.png", f"Coverage ({first}), {len(designs)} designs")
+    seconds = designs["gt_seconds"].dropna()
+    metrics = {
+        "designs": int(len(designs)),
+        "seconds_per_design_median": float(seconds.median()) if len(seconds) else None,
+        "seconds_per_design_mean": float(seconds.mean()) if len(seconds) else None,
+        **{name: {c: int(t.loc[c, "all"]) for c in CATEGORIES} for name, t in tables.items()},
+    }
+    METRICS.parent.mkdir(parents=True, exist_ok=True)
+    METRICS.write_text(json.dumps(metrics, indent=2))
+    t = tables[first]
+    share = t["all"] / max(int(t["all"].sum()), 1)
+    print(
+        f"ground_truth: {len(designs)} designs; {first}: "
+        + ", ".join(f"{c} {share[c]:.1%}" for c in CATEGORIES)
+    )
+
+
+if __name__ == "__main__":
+    main()
