@@ -90,6 +90,53 @@ def _cmd_infer(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_convert(args: argparse.Namespace) -> int:
+    from zonegraph.data.b123d import ConvertedDesign, convert_batch
+    from zonegraph.isolation import run_isolated
+
+    source = Path(args.source)
+    if source.is_dir():
+        batches = sorted(source.rglob("batch_*.py"))
+    elif source.is_file():
+        batches = [source]
+    else:
+        raise ZoneGraphError(str(source), "no such batch file or folder")
+    if not batches:
+        raise ZoneGraphError(str(source), "no batch_*.py files in the folder")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows: list[dict] = []
+    for batch in batches:  # one killable child per batch: a hung OpenCASCADE call stops only it
+        outcome = run_isolated(convert_batch, (str(batch), args.timeout), timeout=None)
+        results: list[ConvertedDesign] = outcome.value if outcome.ok else []
+        if not outcome.ok:
+            rows.append(
+                {"batch": str(batch), "design_id": None, "status": outcome.status, "reason": outcome.reason}
+            )
+        for r in results:
+            if r.ok and r.design_json is not None:
+                (out / f"{r.design_id}.json").write_text(json.dumps(r.design_json))
+            rows.append(
+                {
+                    "batch": str(batch),
+                    "design_id": r.design_id,
+                    "folder": r.folder,
+                    "status": r.status,
+                    "reason": r.reason,
+                    "steps": r.steps,
+                    "seconds": round(r.seconds, 4),
+                }
+            )
+        ok = sum(r.ok for r in results)
+        print(f"{batch.parent.name}/{batch.name}: {ok}/{len(results)} converted", flush=True)
+    counts: dict[str, int] = {}
+    for row in rows:
+        counts[row["status"]] = counts.get(row["status"], 0) + 1
+    (out / "summary.json").write_text(json.dumps({"counts": counts, "designs": rows}, indent=1))
+    print(f"converted {counts.get('ok', 0)} of {len(rows)} designs -> {out} (by status {counts})")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="zonegraph", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -106,6 +153,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=b["seed"], help="seed of the surface samples")
     p.add_argument("--timeout", type=float, default=600.0, help="seconds before the build is stopped")
     p.set_defaults(func=_cmd_build)
+    p = sub.add_parser("convert", help="convert build123d corpus batches to verified design JSON")
+    p.add_argument("source", help="a batch_NNN.py file or a folder of them (searched recursively)")
+    p.add_argument("--out", required=True, help="output folder (one JSON per design, summary.json)")
+    p.add_argument("--timeout", type=float, default=120.0, help="seconds per design")
+    p.set_defaults(func=_cmd_convert)
     d = InferConfig.defaults()
     p = sub.add_parser("infer", help="infer an editable sketch + extrude program that rebuilds a part")
     p.add_argument("target", help="PART.step, PART.brep or DESIGN.json (its final shape)")
