@@ -1,0 +1,123 @@
+"""The core on real parts: zone graphs and heuristic ``infer`` on corpus designs, by timeline folder.
+
+    python -m bench.corpus_bench [--per-folder 25] [--budget 20] [--seed 0] [--workers 2]
+                                 [--corpus ../shared/data/fusion360_b123d] [--out bench_out/corpus]
+
+A seeded sample with the same number of designs from every timeline folder of the build123d corpus
+(``01_2ops`` ... ``08_21plus``). Each design is converted to our JSON (``zonegraph.data.b123d``)
+and its final shape goes through exactly what a user's ``zonegraph infer PART --guide heuristic
+--budget B`` does, in its own process under a timeout (one core each, ``--workers`` side by side):
+zone graph, search, rebuild, B-rep IoU. Prints per folder: zone graphs built, exact rate (B-rep
+IoU >= 0.9999), mean B-rep IoU, median time to exact, and every failure with its status; writes
+``results.json`` and ``results.md`` under ``--out``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tempfile
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from zonegraph.configs import InferConfig
+from zonegraph.data.b123d import CorpusEntry, convert_design, list_corpus
+from zonegraph.isolation import run_isolated
+from zonegraph.reconstruction import infer
+
+CORPUS = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_b123d"
+
+
+def sample(corpus: Path, per_folder: int, seed: int) -> list[CorpusEntry]:
+    """``per_folder`` designs from every timeline folder, seeded (all of a smaller folder)."""
+    rng = np.random.default_rng(seed)
+    entries = list_corpus(corpus)
+    out = []
+    for folder in sorted({e.folder for e in entries}):
+        members = [e for e in entries if e.folder == folder]
+        picks = rng.choice(len(members), size=min(per_folder, len(members)), replace=False)
+        out += [members[i] for i in sorted(picks)]
+    return out
+
+
+def _infer(entry: CorpusEntry, budget: float, work: str) -> dict:
+    """Convert one design, then infer its final shape as a user would."""
+    converted = convert_design(entry.batch, entry.design_id, timeout_s=120)
+    if not converted.ok or converted.design_json is None:
+        return {"status": f"convert_{converted.status}", "reason": converted.reason}
+    path = Path(work) / f"{entry.design_id}.json"
+    path.write_text(json.dumps(converted.design_json))
+    return infer(path, Path(work) / entry.design_id, InferConfig(budget_s=budget), render=False).to_dict()
+
+
+def _job(args: tuple[CorpusEntry, float, str]) -> dict:
+    entry, budget, work = args
+    outcome = run_isolated(_infer, args, timeout=3 * budget + 240)
+    row = {"design_id": entry.design_id, "folder": entry.folder, "seconds": outcome.seconds}
+    if outcome.ok:
+        row.update(outcome.value)
+    else:
+        row.update(status=outcome.status, reason=outcome.reason)
+    return row
+
+
+def summarise(rows: list[dict]) -> str:
+    """A Markdown table by folder, and the failures."""
+    lines = [
+        "| folder | designs | zone graph | exact | mean B-rep IoU | median time to exact s | zones median |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    groups = sorted({r["folder"] for r in rows}) + ["all"]
+    for folder in groups:
+        rs = [r for r in rows if folder in ("all", r["folder"])]
+        converted = [r for r in rs if not str(r.get("status", "")).startswith("convert_")]
+        searched = [r for r in converted if r.get("status") in ("exact", "partial", "rebuild_failed")]
+        exact = [r for r in searched if r.get("exact")]
+        iou = (
+            np.mean([r.get("iou_brep", 0.0) if r in searched else 0.0 for r in converted]) if converted else 0
+        )
+        tte = f"{np.median([r['time_to_best_s'] for r in exact]):.3f}" if exact else "-"
+        zones = f"{np.median([r['zones'] for r in searched]):.0f}" if searched else "-"
+        lines.append(
+            f"| {folder} | {len(converted)} | {len(searched) / max(len(converted), 1):.0%} | "
+            f"{len(exact) / max(len(converted), 1):.0%} | {iou:.3f} | {tte} | {zones} |"
+        )
+    failures = [r for r in rows if r.get("status") not in ("exact", "partial")]
+    lines.append("")
+    for r in failures:
+        lines.append(f"- {r['design_id']} ({r['folder']}): {r.get('status')}: {r.get('reason', '')[:160]}")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--corpus", type=Path, default=CORPUS)
+    parser.add_argument("--per-folder", type=int, default=25)
+    parser.add_argument("--budget", type=float, default=20.0)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=Path("bench_out/corpus"))
+    args = parser.parse_args()
+    if not args.corpus.is_dir():
+        raise SystemExit(f"corpus not found at {args.corpus} (clone Fusion360GalleryDataset-build123d there)")
+    entries = sample(args.corpus, args.per_folder, args.seed)
+    print(f"{len(entries)} designs, heuristic, budget {args.budget:g} s, {args.workers} workers", flush=True)
+    rows = []
+    with tempfile.TemporaryDirectory() as work, ProcessPoolExecutor(args.workers) as pool:
+        jobs = [(e, args.budget, work) for e in entries]
+        for i, row in enumerate(pool.map(_job, jobs), 1):
+            rows.append(row)
+            if i % 10 == 0 or i == len(jobs):
+                done = sum(bool(r.get("exact")) for r in rows)
+                print(f"  {i}/{len(jobs)} designs, {done} exact", flush=True)
+    table = summarise(rows)
+    print(table)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
+    (args.out / "results.md").write_text(table + "\n")
+
+
+if __name__ == "__main__":
+    main()
