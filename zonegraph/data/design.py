@@ -242,6 +242,8 @@ Entity = Union[Sketch, Extrude]
 
 @dataclass(frozen=True)
 class Design:
+    """A Fusion 360 Gallery design: its timeline of sketches and extrudes, in centimetres."""
+
     id: str
     timeline: tuple[Entity, ...]
     properties: DesignProperties | None = None
@@ -272,6 +274,11 @@ def load_design(path: str | Path) -> Design:
 
 
 def parse_design(data: Any, design_id: str, source: str = "") -> Design:
+    """A design from parsed JSON; every reference is checked before any geometry is built.
+
+    Raises:
+        InputError: not a design at all; DesignError or UnsupportedFeatureError: naming the entity.
+    """
     name = source or design_id
     if not isinstance(data, dict) or "timeline" not in data or "entities" not in data:
         raise InputError(name, "not a Fusion 360 Gallery design (no timeline/entities)")

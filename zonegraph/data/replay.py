@@ -110,7 +110,15 @@ def as_shape(bodies: Iterable[Solid]) -> Shape:
 
 
 def replay(design: Design) -> ReplayResult:
-    """Replay every extrude of ``design`` in timeline order."""
+    """Replay every extrude of ``design`` in timeline order, with Fusion's Boolean semantics.
+
+    Returns:
+        Every step's tool body and bodies, and the final bodies (in the design's centimetres).
+
+    Raises:
+        DesignError, UnsupportedFeatureError: a profile or extent that cannot be built exactly;
+        ReplayError: an OpenCASCADE Boolean failed.
+    """
     sketches: dict[str, Sketch] = {}
     bodies: tuple[Solid, ...] = ()
     steps = []

@@ -23,6 +23,17 @@ from zonegraph.zones.model import ZoneGraph
 
 @dataclass(frozen=True)
 class SearchConfig:
+    """How far a search may go: top-k width (shrinking with depth), depth, time and work bounds.
+
+    Args:
+        k: proposals kept per state.
+        k_decay: decrease of k per depth level (the paper's harder runs: k 15, decay 0.5).
+        max_depth: longest program searched.
+        budget_s: wall-clock budget in seconds.
+        max_expansions: a work bound (states expanded); unlike seconds it is the same on any
+            machine, so seeded runs bounded by it are reproducible.
+    """
+
     k: int = 5
     k_decay: float = 0.0  # per depth level: the paper's harder runs used k = 15, decay 0.5
     max_depth: int = 20
@@ -30,11 +41,18 @@ class SearchConfig:
     max_expansions: int | None = None
 
     def k_at(self, depth: int) -> int:
+        """Proposals kept at ``depth`` (at least one)."""
         return max(1, int(round(self.k - self.k_decay * depth)))
 
 
 @dataclass
 class SearchResult:
+    """The best canvas a search found and how it got there.
+
+    Shapes:
+        canvas: (Z,) bool, the best canvas; steps: the proposals leading to it, in order.
+    """
+
     exact: bool
     iou: float
     steps: list[Proposal]
@@ -60,7 +78,19 @@ def search(
     config: SearchConfig = SearchConfig(),
     generator: ProposalGenerator | None = None,
 ) -> SearchResult:
-    """Find a proposal sequence whose canvas equals the target's zones."""
+    """Find a proposal sequence whose canvas equals the target's zones (best-first, top-k).
+
+    Args:
+        graph: the zone graph; its ``zone_inside`` is the target.
+        ranker: scores all proposals of a state at once (see :class:`Ranker`).
+        config: width, depth and budget.
+        generator: a proposal generator to reuse (its memoised sweeps carry over); by default a
+            new level-1 generator.
+
+    Returns:
+        The best canvas seen (highest zone IoU, then fewest steps), exact or not, with the anytime
+        trace and per-expansion statistics.
+    """
     gen = generator or ProposalGenerator(graph)
     target = graph.zone_inside.astype(bool)
     t0 = time.perf_counter()

@@ -32,6 +32,7 @@ class ProgramStep:
     distance: float
 
     def tool(self) -> Solid:
+        """The extruded sketch faces (fused when there are several)."""
         d = Vector(*self.direction) * self.distance
         solids = [Solid.extrude(f, d) for f in self.faces]
         return solids[0] if len(solids) == 1 else solids[0].fuse(*solids[1:]).clean()
@@ -55,6 +56,14 @@ def merge_faces(faces: list) -> list[Face]:
 
 
 def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGenerator) -> list[ProgramStep]:
+    """Real sketches and extrusions, in the input's units, for a found proposal sequence.
+
+    Each sketch is the union of the proposal's partition faces (merged into clean faces), mapped
+    back from the normalised frame; the extrusion runs from the start plane to the end plane.
+
+    Raises:
+        ValueError: the graph was loaded without its zone solids.
+    """
     faces = partition_faces(graph)
     norm = graph.normalization
     out = []

@@ -26,11 +26,19 @@ def zone_iou(graph: ZoneGraph, canvas: np.ndarray, target: np.ndarray) -> float:
 class Ranker(Protocol):
     """Scores all proposals of one state in one call (a network batches them); higher is better."""
 
-    def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray: ...
+    def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
+        """One score per proposal, higher first.
+
+        Shapes:
+            canvas: (Z,) bool; returns (P,) float for P proposals.
+        """
+        ...
 
 
 @dataclass
 class RandomRanker:
+    """The paper's random baseline: uniform scores from a generator seeded once per search."""
+
     seed: int = 0
     rng: np.random.Generator = field(init=False)
 
@@ -38,6 +46,7 @@ class RandomRanker:
         self.rng = np.random.default_rng(self.seed)
 
     def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
+        """(P,) uniform random scores."""
         return self.rng.random(len(proposals))
 
 
@@ -46,6 +55,7 @@ class HeuristicRanker:
     operation, ties broken by volumetric IoU (scaled below the smallest label step)."""
 
     def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
+        """(P,) scores: label agreement in [0, 1] plus a tie-breaking IoU below 1 / (Z + 1)."""
         target = graph.zone_inside
         after = np.stack([p.apply(canvas) for p in proposals])  # (P, Z)
         agree = (after == target).sum(axis=1) / graph.n_zones
@@ -56,6 +66,11 @@ class HeuristicRanker:
 
 
 def make_ranker(guide: str, seed: int = 0) -> Ranker:
+    """The ranker a guide name stands for (``heuristic`` or ``random``, seeded).
+
+    Raises:
+        ValueError: an unknown guide.
+    """
     if guide == "heuristic":
         return HeuristicRanker()
     if guide == "random":

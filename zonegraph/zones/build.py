@@ -125,10 +125,27 @@ def build_zone_graph(
     keep_solids: bool = True,
     check: bool = True,
 ) -> ZoneGraph:
-    """The zone graph of ``target``; raises ZoneGraphBuildError with a status on failure.
+    """The zone graph of ``target``, checked against every invariant.
 
     The general fuse occasionally fails quietly (it drops splits it cannot compute), which only
     the invariants reveal; each fuzzy value in ``fuzzy`` is tried in turn until they hold.
+
+    Args:
+        target: a build123d or TopoDS shape, or a list of them; only their solids are used.
+        simplify: face-loop simplification (paper sec. 3).
+        samples: surface samples per zone for the network (0: none).
+        seed: seed of the samples.
+        fuzzy: fuzzy values of the general fuse, tried in order.
+        source: names the input in errors.
+        keep_solids: keep the zone solids (needed to rebuild programs and export meshes).
+        check: raise on a broken invariant (turned off only to inspect a failed build).
+
+    Returns:
+        The graph in the normalised frame (centred, unit box diagonal).
+
+    Raises:
+        ZoneGraphBuildError: with a status: ``invalid_input``, ``not_a_solid``, ``fuse_failed``,
+            ``target_mismatch``, ``no_interior_point`` or ``disconnected``.
     """
     timer = _Timer()
     shape = _target_shape(target, source)

@@ -41,6 +41,8 @@ def _unfixed(column: pa.ChunkedArray, shape: tuple[int, ...], dtype: DTypeLike =
 
 
 def save_zone_graph(graph: ZoneGraph, folder: str | Path) -> Path:
+    """Write a graph as Parquet tables plus ``zones.brep`` (see the module docstring); returns
+    the folder."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     meta = {
@@ -109,6 +111,15 @@ def save_zone_graph(graph: ZoneGraph, folder: str | Path) -> Path:
 
 
 def load_zone_graph(folder: str | Path, solids: bool = True) -> ZoneGraph:
+    """Read a saved graph back, equal to the one saved.
+
+    Args:
+        folder: written by :func:`save_zone_graph`.
+        solids: also read the zone solids (``zones.brep``); skip them for array-only work.
+
+    Raises:
+        InputError: no graph in the folder.
+    """
     folder = Path(folder)
     if not (folder / "zones.parquet").is_file():
         raise InputError(str(folder), "no zone graph here (zones.parquet missing)")
