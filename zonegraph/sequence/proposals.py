@@ -80,6 +80,19 @@ class Proposal:
         )
 
 
+@dataclass(frozen=True)
+class _Candidates:
+    """The extrusions of one face group on one plane pair, as a union and a subtraction each.
+
+    Shapes:
+        volumes: (K, Z) bool, one row per sketch whose prism the zones fill exactly.
+    """
+
+    volumes: np.ndarray
+    union: tuple[Proposal, ...]
+    subtract: tuple[Proposal, ...]
+
+
 class ProposalGenerator:
     """Proposals for any canvas of one zone graph, with every canvas-independent part precomputed."""
 
@@ -93,7 +106,9 @@ class ProposalGenerator:
         self._links_on = self._links_by_plane(planes)
         self._zone_faces = self._faces_of_zones()
         self._sweeps: dict[tuple[int, int, int], np.ndarray | None] = {}
+        self._groups: dict[tuple[int, int, bytes], _Candidates] = {}
         self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
+        self._flatten_pairs()
 
     # ------------------------------------------------------------------ static structure
 
@@ -116,6 +131,17 @@ class ProposalGenerator:
             if plane in out:
                 out[plane].append((a, b))
         return out
+
+    def _flatten_pairs(self) -> None:
+        """Every pair's start-plane faces in one array, so a canvas is classified in one pass."""
+        beyond = [self._beyond[pair] for pair in self.pairs]
+        lengths = np.array([len(b) for b in beyond], np.int64)
+        self._ends = np.cumsum(lengths)
+        self._starts = self._ends - lengths
+        flat = np.concatenate(beyond) if beyond else np.zeros(0, np.int64)
+        self._flat_valid = flat >= 0
+        self._flat_zone = np.where(self._flat_valid, flat, 0)
+        self._flat_in_t = self.target[self._flat_zone] & self._flat_valid
 
     def direction(self, s: int, e: int) -> np.ndarray:
         """The extrusion vector d from plane s to plane e."""
@@ -233,31 +259,56 @@ class ProposalGenerator:
             volume |= swept
         return volume
 
+    def _candidates(self, s: int, e: int, mask: np.ndarray) -> _Candidates:
+        """The sketches of the faces ``mask`` selects on plane s, swept to e (memoised).
+
+        A group's candidates depend only on which faces are in it, not on the rest of the
+        canvas, and the same groups recur across the canvases of a search and of random
+        completions: generating them once per group is what makes an expansion cheap."""
+        key = (s, e, mask.tobytes())
+        hit = self._groups.get(key)
+        if hit is None:
+            volumes, union, subtract = [], [], []
+            for sketch in self.sketches(self.faces_on[s][mask], s):
+                volume = self.extrusion(sketch, s, e)
+                if volume is None or not volume.any():
+                    continue
+                volumes.append(volume)
+                union.append(Proposal(s, e, sketch, volume, Op.UNION))
+                subtract.append(Proposal(s, e, sketch, volume, Op.SUBTRACT))
+            matrix = np.array(volumes, bool).reshape(len(volumes), self.graph.n_zones)
+            hit = self._groups[key] = _Candidates(matrix, tuple(union), tuple(subtract))
+        return hit
+
     def proposals(self, canvas: np.ndarray) -> list[Proposal]:
-        """Every distinct (volume, operation) reachable from ``canvas`` by one extrusion."""
-        target = self.target
+        """Every distinct (volume, operation) reachable from ``canvas`` by one extrusion.
+
+        Shapes:
+            canvas: (Z,) bool. A union is proposed when the volume has zones outside the canvas,
+            a subtraction when it has zones inside it, so no proposal leaves the canvas unchanged.
+        """
         seen: dict[tuple[bytes, int], Proposal] = {}
-        for s, e in self.pairs:
-            faces = self.faces_on[s]
-            beyond = self._beyond[(s, e)]
-            valid = beyond >= 0
-            z = np.where(valid, beyond, 0)
-            in_c, in_t = canvas[z] & valid, target[z] & valid
-            groups = (
-                faces[in_c & ~in_t],
-                faces[in_t & ~in_c],
-                faces[valid & (in_t | ~in_c)],
-            )
-            for group in groups:
-                for sketch in self.sketches(group, s):
-                    volume = self.extrusion(sketch, s, e)
-                    if volume is None or not volume.any():
-                        continue
-                    inside = bool((volume & ~canvas).sum() == 0)
-                    outside = not (volume & canvas).any()
-                    ops = [Op.SUBTRACT] if inside else [Op.UNION] if outside else [Op.UNION, Op.SUBTRACT]
-                    for op in ops:
-                        p = Proposal(s, e, sketch, volume, op)
-                        if not np.array_equal(p.apply(canvas), canvas):
-                            seen.setdefault(p.key, p)
+        in_c = canvas[self._flat_zone] & self._flat_valid  # every pair's faces at once
+        groups = (
+            in_c & ~self._flat_in_t,
+            self._flat_in_t & ~in_c,
+            self._flat_valid & (self._flat_in_t | ~in_c),
+        )
+        counts = [np.concatenate(([0], np.cumsum(g))) for g in groups]
+        filled = [c[self._ends] > c[self._starts] for c in counts]  # a group has faces on the pair
+        for i, (s, e) in enumerate(self.pairs):
+            a, b = self._starts[i], self._ends[i]
+            for g, mask in enumerate(groups):
+                if not filled[g][i]:
+                    continue
+                cand = self._candidates(s, e, mask[a:b])
+                if not cand.union:
+                    continue
+                adds = (cand.volumes & ~canvas).any(axis=1)
+                removes = (cand.volumes & canvas).any(axis=1)
+                for k in range(len(cand.union)):
+                    if adds[k]:
+                        seen.setdefault(cand.union[k].key, cand.union[k])
+                    if removes[k]:
+                        seen.setdefault(cand.subtract[k].key, cand.subtract[k])
         return list(seen.values())
