@@ -40,7 +40,7 @@ def test_replay_writes_steps_and_summary(samples_dir, tmp_path):
     assert sum(s.volume for s in final) == pytest.approx(summary["volume"] * 1000, rel=1e-6)
 
 
-BATCH = '''
+BATCH = """
 from build123d import *
 
 def model_1_a_0000():
@@ -62,7 +62,7 @@ MODELS = {
     "model_1_a_0000": {"func": model_1_a_0000, "volume": 7.2146018366, "area": 29.5707963268},
     "model_1_b_0000": {"func": model_1_b_0000, "volume": 1.0, "area": 1.0},
 }
-'''
+"""
 
 
 def test_convert_writes_verified_json_and_a_summary(tmp_path):

@@ -7,12 +7,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pyarrow.parquet as pq
 
 from zonegraph.configs import BuildConfig
 from zonegraph.data.targets import load_target
 from zonegraph.geometry.shapes import read_shape, read_solids
 from zonegraph.sequence.best_first import SearchConfig, search
-from zonegraph.sequence.ground_truth import ground_truth
+from zonegraph.sequence.ground_truth import ground_truth, search_op
+from zonegraph.sequence.labels import GTOperation, label_design, label_tables
 from zonegraph.sequence.rankers import HeuristicRanker
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
@@ -108,3 +110,53 @@ def ground_truth_and_coverage(
                 }
             )
     return out
+
+
+def label_and_save(
+    graph_dir: str,
+    gt_steps: list[dict[str, Any]],
+    design_id: str,
+    split: str,
+    out_dir: str,
+    seed: int = 0,
+    level: int = 1,
+    multiplier: float = 1.0,
+    slack: int = 2,
+) -> dict[str, Any]:
+    """Ternary labels of one design, written as its two Parquet shards; returns the counts.
+
+    Args:
+        graph_dir: the saved zone graph the ground truth was mapped onto.
+        gt_steps: the ground-truth stage's rows of that graph, in step order: ``operation``,
+            ``gt_zones`` (zone ids), ``captured`` (at ``level``) and ``reason``.
+        out_dir: receives ``proposals/<design_id>.parquet`` and ``steps/<design_id>.parquet``.
+    """
+    graph = load_zone_graph(graph_dir)
+    gt = []
+    for row in gt_steps:
+        zones = np.zeros(graph.n_zones, bool)
+        zones[np.asarray(row["gt_zones"], dtype=int)] = True
+        gt.append(
+            GTOperation(
+                zones, search_op(row["operation"]), bool(row["captured"]), row["operation"], row["reason"]
+            )
+        )
+    steps = label_design(graph, gt, design_id, seed=seed, level=level, multiplier=multiplier, slack=slack)
+    proposals, step_rows = label_tables(steps, gt, design_id, split)
+    for name, table in (("proposals", proposals), ("steps", step_rows)):
+        folder = Path(out_dir) / name
+        folder.mkdir(parents=True, exist_ok=True)
+        tmp = folder / f"{design_id}.parquet.tmp"
+        pq.write_table(table, tmp)
+        tmp.replace(folder / f"{design_id}.parquet")
+    labels = np.asarray(proposals.column("label").to_pylist(), dtype=int)
+    return {
+        "steps": len(steps),
+        "labelled_steps": sum(any(x.is_gt for x in st.proposals) for st in steps),
+        "proposals": len(labels),
+        "positives": int((labels == 1).sum()),
+        "negatives": int((labels == -1).sum()),
+        "neutrals": int((labels == 0).sum()),
+        "completions": int(sum(proposals.column("completions").to_pylist())),
+        "zones": graph.n_zones,
+    }

@@ -1,4 +1,4 @@
-"""The generate and replay stages on a real-data folder, as a user with r1.0.1 would run them."""
+"""The stages from generate to labels on a real-data folder, as a user with r1.0.1 would run them."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import pandas as pd
+import pyarrow.dataset as ds
 import yaml
 
 
@@ -28,6 +29,18 @@ def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):
         "synthetic": {"count": 0, "seed": 0, "timeout_s": 60},
         "dask": {"scheduler": None, "n_workers": 2},
         "replay": {"timeout_s": 60},
+        "zonegraph": {"simplify": True, "samples": 16, "seed": 0, "timeout_s": 120},
+        "ground_truth": {"levels": [1, 3], "full_graph": True, "search_budget_s": 0.5, "timeout_s": 120},
+        "labels": {
+            "splits": ["train", "test"],
+            "limit": None,
+            "limit_seed": 0,
+            "level": 1,
+            "multiplier": 1.0,
+            "slack": 2,
+            "seed": 0,
+            "timeout_s": 120,
+        },
     }
     (tmp_path / "params.yaml").write_text(yaml.safe_dump(params))
     assert "22 designs" in run_stage("pipelines.generate", tmp_path)
@@ -39,3 +52,28 @@ def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):
     assert (tmp_path / "data/replay/breps/Couch/01_tool.brep").is_file()
     # A re-run reuses every finished design.
     assert "22 of 22 designs already done" in run_stage("pipelines.replay", tmp_path)
+
+    # Zone graphs, the ground truth and labels.
+    run_stage("pipelines.zonegraphs", tmp_path)
+    assert "ground_truth: 22 designs" in run_stage("pipelines.ground_truth", tmp_path)
+    gt = pd.read_parquet(tmp_path / "data/gt/designs.parquet").set_index("design_id")
+    assert gt.loc["Couch", "simplified_captured_l1"] and gt.loc["Couch", "simplified_reaches_target"]
+    out = run_stage("pipelines.labels", tmp_path)
+    assert "labels:" in out
+    proposals = ds.dataset(tmp_path / "data/labels/proposals").to_table().to_pandas()
+    steps = ds.dataset(tmp_path / "data/labels/steps").to_table().to_pandas()
+    assert "Couch" in set(proposals["design_id"])
+    per_step = proposals.groupby(["design_id", "step"])["label"]
+    assert (per_step.apply(lambda x: (x == 1).sum()) == 1).all()
+    assert steps["captured"].sum() == len(per_step)
+    # An interrupted run resumes: the finished designs are kept, the lost one recomputed, equal.
+    (tmp_path / "data/labels/records/Couch.json").unlink()
+    (tmp_path / "data/labels/proposals/Couch.parquet").unlink()
+    assert "already done, resuming" in run_stage("pipelines.labels", tmp_path)
+    again = ds.dataset(tmp_path / "data/labels/proposals").to_table().to_pandas()
+    pd.testing.assert_frame_equal(
+        again.sort_values(["design_id", "step", "zones"], key=lambda c: c.astype(str)).reset_index(drop=True),
+        proposals.sort_values(["design_id", "step", "zones"], key=lambda c: c.astype(str)).reset_index(
+            drop=True
+        ),
+    )

@@ -39,6 +39,13 @@ def test_round_trip_is_equal(samples_dir, tmp_path):
             assert a == b, f.name
 
 
+def test_graph_without_surface_samples_round_trips(tmp_path):
+    graph = build_zone_graph(Box(2, 1, 1) - Box(1, 1, 1), samples=0)
+    loaded = load_zone_graph(save_zone_graph(graph, tmp_path / "g"))
+    assert loaded.zone_points.shape == (graph.n_zones, 0, 3) == loaded.zone_normals.shape
+    np.testing.assert_array_equal(loaded.zone_inside, graph.zone_inside)
+
+
 def test_samples_are_seeded(samples_dir):
     target = load_target(samples_dir / "Couch.json")
     a, b = (build_zone_graph(target, samples=32, seed=s) for s in (1, 1))

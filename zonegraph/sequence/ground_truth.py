@@ -53,9 +53,14 @@ class GTStep:
     @property
     def op(self) -> Op | None:
         """The search's operation for this step (None: an intersect has none)."""
-        if self.operation in ("new_body", "join"):
-            return Op.UNION
-        return Op.SUBTRACT if self.operation == "cut" else None
+        return search_op(self.operation)
+
+
+def search_op(operation: str) -> Op | None:
+    """The search's operation for Fusion's ``operation`` (None: an intersect has no proposal)."""
+    if operation in ("new_body", "join"):
+        return Op.UNION
+    return Op.SUBTRACT if operation == "cut" else None
 
 
 @dataclass

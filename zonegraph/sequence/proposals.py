@@ -92,6 +92,15 @@ class _Candidates:
     union: tuple[Proposal, ...]
     subtract: tuple[Proposal, ...]
 
+    @cached_property
+    def rows(self) -> tuple[np.ndarray, tuple[Proposal, ...]]:
+        """Each volume as a union then a subtraction: (2K, bytes) packed keys and the proposals."""
+        packed = np.packbits(self.volumes, axis=1)
+        keys = np.repeat(packed, 2, axis=0)
+        ops = np.tile(np.array([Op.UNION, Op.SUBTRACT], np.int8).view(np.uint8), len(self.volumes))
+        interleaved = tuple(p for pair in zip(self.union, self.subtract, strict=True) for p in pair)
+        return np.concatenate([keys, ops[:, None]], axis=1), interleaved
+
 
 class ProposalGenerator:
     """Proposals for any canvas of one zone graph, with every canvas-independent part precomputed."""
@@ -287,7 +296,6 @@ class ProposalGenerator:
             canvas: (Z,) bool. A union is proposed when the volume has zones outside the canvas,
             a subtraction when it has zones inside it, so no proposal leaves the canvas unchanged.
         """
-        seen: dict[tuple[bytes, int], Proposal] = {}
         in_c = canvas[self._flat_zone] & self._flat_valid  # every pair's faces at once
         groups = (
             in_c & ~self._flat_in_t,
@@ -296,19 +304,31 @@ class ProposalGenerator:
         )
         counts = [np.concatenate(([0], np.cumsum(g))) for g in groups]
         filled = [c[self._ends] > c[self._starts] for c in counts]  # a group has faces on the pair
+        found = []
         for i, (s, e) in enumerate(self.pairs):
             a, b = self._starts[i], self._ends[i]
             for g, mask in enumerate(groups):
-                if not filled[g][i]:
-                    continue
-                cand = self._candidates(s, e, mask[a:b])
-                if not cand.union:
-                    continue
-                adds = (cand.volumes & ~canvas).any(axis=1)
-                removes = (cand.volumes & canvas).any(axis=1)
-                for k in range(len(cand.union)):
-                    if adds[k]:
-                        seen.setdefault(cand.union[k].key, cand.union[k])
-                    if removes[k]:
-                        seen.setdefault(cand.subtract[k].key, cand.subtract[k])
-        return list(seen.values())
+                if filled[g][i]:
+                    cand = self._candidates(s, e, mask[a:b])
+                    if cand.union:
+                        found.append(cand)
+        if not found:
+            return []
+        return self._distinct(found, canvas)
+
+    @staticmethod
+    def _distinct(found: list[_Candidates], canvas: np.ndarray) -> list[Proposal]:
+        """The proposals of ``found`` that change ``canvas``, the first of each key, in order.
+
+        All candidates at once: a union must add a zone, a subtraction remove one; duplicates
+        (the same volume from another sketch or plane pair) are dropped by their packed key."""
+        volumes = np.concatenate([c.volumes for c in found])
+        adds = (volumes & ~canvas).any(axis=1)
+        removes = (volumes & canvas).any(axis=1)
+        valid = np.stack([adds, removes], axis=1).ravel()
+        keys = np.concatenate([c.rows[0] for c in found])[valid]
+        props = [p for c in found for p in c.rows[1]]
+        index = np.flatnonzero(valid)
+        rows = np.ascontiguousarray(keys).view(np.dtype((np.void, keys.shape[1]))).ravel()
+        _, first = np.unique(rows, return_index=True)
+        return [props[index[i]] for i in np.sort(first)]

@@ -29,9 +29,14 @@ from zonegraph.zones.model import ZoneGraph
 META_KEY = b"zonegraph"
 
 
-def _fixed(arr: np.ndarray, dtype: DTypeLike | None = None) -> pa.FixedSizeListArray:
+def _fixed(arr: np.ndarray, dtype: DTypeLike | None = None) -> pa.Array:
+    """One fixed-width list per row; rows of width 0 (a graph built without surface samples)
+    become empty lists, which Arrow's fixed-size lists cannot hold."""
     arr = np.asarray(arr, dtype=dtype)
     width = int(np.prod(arr.shape[1:])) if arr.ndim > 1 else 1
+    if width == 0:
+        offsets = pa.array(np.zeros(len(arr) + 1, np.int32))
+        return pa.ListArray.from_arrays(offsets, pa.array([], type=pa.from_numpy_dtype(arr.dtype)))
     return pa.FixedSizeListArray.from_arrays(pa.array(arr.reshape(-1)), width)
 
 

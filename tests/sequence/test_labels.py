@@ -1,0 +1,147 @@
+"""Ternary labels by random completions, on hand-built parts whose answers are known and on real
+samples (invariants, determinism, the Parquet tables)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+from build123d import Box, Cylinder, Pos
+
+from tests.conftest import requires_samples
+from zonegraph.data.design import load_design
+from zonegraph.data.replay import replay
+from zonegraph.jobs import label_and_save
+from zonegraph.sequence.ground_truth import ground_truth
+from zonegraph.sequence.labels import (
+    NEGATIVE,
+    NEUTRAL,
+    POSITIVE,
+    PROPOSAL_SCHEMA,
+    STEP_SCHEMA,
+    GTOperation,
+    LabelledStep,
+    label_design,
+    label_tables,
+)
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.zones.storage import save_zone_graph
+
+PLATE = Box(4, 4, 1)
+HOLE_A, HOLE_B = Pos(-1, 0, 0) * Cylinder(0.5, 1), Pos(1, 0, 0) * Cylinder(0.5, 1)
+
+
+def _labelled(part, tools, operations, **kwargs):
+    graph = build_zone_graph(part, samples=0, simplify=False)
+    gt = ground_truth(graph, [t.wrapped for t in tools], operations)
+    assert gt.reaches_target, gt.reason
+    ops = [GTOperation(s.zones, s.op, s.captured[1], s.operation, s.reason) for s in gt.steps]
+    return graph, ops, label_design(graph, ops, "part", **kwargs)
+
+
+def _others(step: LabelledStep):
+    return [x for x in step.proposals if not x.is_gt]
+
+
+def _check_invariants(graph, steps: list[LabelledStep]) -> None:
+    for step in steps:
+        if not step.proposals:
+            assert step.reason
+            continue
+        assert sum(x.label == POSITIVE for x in step.proposals) == sum(x.is_gt for x in step.proposals) == 1
+        others = _others(step)
+        if others:
+            assert any(x.label == NEGATIVE for x in others)
+            assert all(0.0 <= x.p <= 1.0 and x.completions >= 1 for x in others)
+            assert all(x.label == NEGATIVE for x in others if x.p == 0)
+        for x in step.proposals:
+            assert x.proposal.zones.shape == (graph.n_zones,) and x.proposal.zones.any()
+
+
+def test_plate_with_two_holes_alternative_order_is_neutral_and_a_wrong_cut_negative():
+    # GT: plate, cut hole A, cut hole B. With no slack, at the first cut only proposals that can
+    # finish in the two remaining steps have p > 0: cutting B first (the other order) can, cutting
+    # the plate's web away cannot.
+    graph, ops, steps = _labelled(
+        PLATE - HOLE_A - HOLE_B, [PLATE, HOLE_A, HOLE_B], ["new_body", "cut", "cut"], slack=0, multiplier=10
+    )
+    _check_invariants(graph, steps)
+    cut = steps[1]
+    by_zones = {frozenset(np.flatnonzero(x.proposal.zones)): x for x in cut.proposals}
+    hole_b = frozenset(np.flatnonzero(ops[2].zones))
+    web = frozenset(np.flatnonzero(graph.zone_inside))
+    assert by_zones[frozenset(np.flatnonzero(ops[1].zones))].label == POSITIVE
+    assert by_zones[hole_b].label == NEUTRAL and by_zones[hole_b].p > 0
+    assert by_zones[hole_b | frozenset(np.flatnonzero(ops[1].zones))].p == 1.0  # both holes at once
+    assert by_zones[web].label == NEGATIVE and by_zones[web].p == 0.0
+
+
+def test_every_dead_end_is_negative():
+    # Plate with one hole, at the cut: the only other proposal removes the plate's web, and its
+    # inverse (adding the web back) is banned, so no completion reaches the target.
+    graph, _, steps = _labelled(PLATE - HOLE_A, [PLATE, HOLE_A], ["new_body", "cut"], multiplier=20)
+    _check_invariants(graph, steps)
+    others = _others(steps[1])
+    assert others and all(x.p == 0.0 and x.label == NEGATIVE for x in others)
+
+
+def test_when_every_proposal_can_finish_exactly_one_is_negative():
+    # At the last cut of the two-hole plate every alternative can still reach the target.
+    graph, _, steps = _labelled(
+        PLATE - HOLE_A - HOLE_B, [PLATE, HOLE_A, HOLE_B], ["new_body", "cut", "cut"], multiplier=20
+    )
+    others = _others(steps[2])
+    assert len(others) >= 2 and all(x.p > 0 for x in others)
+    negatives = [x for x in others if x.label == NEGATIVE]
+    assert len(negatives) == 1 and negatives[0].p == min(x.p for x in others)
+    assert all(x.label == NEUTRAL for x in others if x is not negatives[0])
+
+
+def test_uncaptured_step_has_a_reason_and_no_labels():
+    graph, ops, _ = _labelled(PLATE - HOLE_A, [PLATE, HOLE_A], ["new_body", "cut"])
+    ops[1] = GTOperation(ops[1].zones, ops[1].op, False, "cut", "no proposal has the GT extrusion")
+    steps = label_design(graph, ops, "part")
+    assert steps[0].proposals and not steps[1].proposals
+    assert steps[1].reason == "no proposal has the GT extrusion"
+
+
+def test_seeded_labels_are_identical_and_seeds_differ():
+    parts = (PLATE - HOLE_A - HOLE_B, [PLATE, HOLE_A, HOLE_B], ["new_body", "cut", "cut"])
+    runs = [_labelled(*parts, seed=seed) for seed in (0, 0, 1)]
+    tables = [label_tables(steps, ops, "d", "train")[0] for _, ops, steps in runs]
+    assert tables[0].equals(tables[1])
+    assert not tables[0].column("p").equals(tables[2].column("p"))  # the seed is used
+
+
+@requires_samples
+@pytest.mark.parametrize("name", ["Couch.json", "Pattern4-SteppedStartEndFace_17dd857d_0000.json"])
+def test_real_samples_keep_the_invariants_and_write_readable_shards(samples_dir, tmp_path, name):
+    r = replay(load_design(samples_dir / name))
+    graph = build_zone_graph(list(r.bodies), samples=0)
+    operations = [s["operation"] for s in r.summary()["steps"]]
+    gt = ground_truth(graph, [s.tool.wrapped for s in r.steps], operations)
+    save_zone_graph(graph, tmp_path / "graph")
+    rows = [
+        {
+            "operation": s.operation,
+            "gt_zones": np.flatnonzero(s.zones).tolist(),
+            "captured": s.captured[1],
+            "reason": s.reason,
+        }
+        for s in gt.steps
+    ]
+    counts = label_and_save(str(tmp_path / "graph"), rows, "sample", "train", str(tmp_path / "labels"))
+    proposals = pq.read_table(tmp_path / "labels" / "proposals" / "sample.parquet")
+    steps = pq.read_table(tmp_path / "labels" / "steps" / "sample.parquet")
+    assert proposals.schema.equals(PROPOSAL_SCHEMA) and steps.schema.equals(STEP_SCHEMA)
+    assert counts["positives"] == sum(s.captured[1] for s in gt.steps) == counts["labelled_steps"] > 0
+    table = proposals.to_pandas()
+    assert set(table["label"]) <= {-1, 0, 1} and (table["label"] == 1).eq(table["is_gt"]).all()
+    for _, step in table.groupby("step"):
+        assert (step["label"] == 1).sum() == 1
+        assert len(step) == 1 or (step["label"] == -1).sum() >= 1
+    zones = [z for zs in table["zones"] for z in zs]
+    assert min(zones) >= 0 and max(zones) < graph.n_zones
+    again = label_and_save(str(tmp_path / "graph"), rows, "sample", "train", str(tmp_path / "again"))
+    assert again == counts
+    assert pq.read_table(tmp_path / "again" / "proposals" / "sample.parquet").equals(proposals)
