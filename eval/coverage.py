@@ -44,6 +44,11 @@ COLOURS = dict(zip(CATEGORIES, plt.get_cmap("tab10").colors, strict=False))
 FAILED = {"timeout": "timeout_or_crash", "crash": "timeout_or_crash", "unsupported": "unsupported"}
 
 
+def _true(value: object) -> bool:
+    """True only for a real true value: a missing cell reads back as NaN, and bool(NaN) is True."""
+    return isinstance(value, (bool, np.bool_)) and bool(value)
+
+
 def category(row: pd.Series, graph: str, level: int) -> str:
     """The coverage category of one design row of ``designs.parquet`` for a graph and level."""
     for stage_status in ("convert_status", "replay_status"):
@@ -60,10 +65,12 @@ def category(row: pd.Series, graph: str, level: int) -> str:
         return "timeout_or_crash"
     if gt_status != "ok":
         return "zone_graph_failed"
-    if bool(row.get(f"{graph}_captured_l{level}")):
+    if _true(row.get(f"{graph}_captured_l{level}")):
         return "gt_captured"
-    if bool(row.get(f"{graph}_search_exact")):
-        return "other_sequence" if bool(row.get(f"{graph}_reaches_target")) else "reachable_without_gt"
+    if _true(row.get(f"{graph}_search_exact")):
+        return "other_sequence" if _true(row.get(f"{graph}_reaches_target")) else "reachable_without_gt"
+    if "intersect" in str(row.get("operations", "")).split(","):
+        return "unsupported"  # an intersect step has no extrusion proposal
     return "not_reconstructed"
 
 
