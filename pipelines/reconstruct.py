@@ -63,13 +63,14 @@ def main() -> None:
     jobs = []
     for guide in cfg["guides"]:
         config = InferConfig.from_mapping({**cfg, "guide": guide})
+        model = (cfg["model"],) if guide == "net" and cfg.get("model") else ()  # its weights count too
         for row in test.itertuples():
             brep = f"{row.brep_dir}/final.brep"
             graph = Path("data/zonegraphs/graphs") / row.design_id
             jobs.append(
                 Job(
                     f"{guide}__{row.design_id}",
-                    fingerprint(code, repr(config), files=(brep, graph)),
+                    fingerprint(code, repr(config), files=(brep, graph, *model)),
                     (brep, str(OUT / guide / row.design_id), config, str(graph)),
                     cost=float(zones.get(row.design_id, 0)),
                 )

@@ -71,8 +71,21 @@ def _cmd_build(args: argparse.Namespace) -> int:
 def _cmd_infer(args: argparse.Namespace) -> int:
     from zonegraph.isolation import run_isolated
     from zonegraph.reconstruction import infer
+    from zonegraph.sequence.rankers import available_guides
 
     config = InferConfig.from_mapping(vars(args))
+    guides = available_guides()
+    if config.guide not in guides:
+        extra = (
+            " (net needs the train extra: pip install 'zonegraph[train]')" if config.guide == "net" else ""
+        )
+        print(
+            f"zonegraph: error: unknown guide {config.guide!r}: {', '.join(guides)}{extra}", file=sys.stderr
+        )
+        return EXIT_USER_ERROR
+    if config.model is not None and not Path(config.model).is_file():
+        print(f"zonegraph: error: {config.model}: no such model checkpoint", file=sys.stderr)
+        return EXIT_USER_ERROR
     timeout = args.timeout or 3 * args.budget_s + 300  # the build and the export are not budgeted
     outcome = run_isolated(infer, (args.target, args.out, config), timeout=timeout)
     if not outcome.ok:
@@ -162,7 +175,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("infer", help="infer an editable sketch + extrude program that rebuilds a part")
     p.add_argument("target", help="PART.step, PART.brep or DESIGN.json (its final shape)")
     p.add_argument("--out", required=True, help="output folder (result.json, sequence.py/.json/.png, steps/)")
-    p.add_argument("--guide", choices=["heuristic", "random"], default=d["guide"], help="proposal ranking")
+    p.add_argument(
+        "--guide", default=d["guide"], help="proposal ranking: heuristic, random or net (the train extra)"
+    )
+    p.add_argument("--model", default=None, help="network guide checkpoint (default: the shipped one)")
     p.add_argument(
         "--budget",
         dest="budget_s",

@@ -22,7 +22,10 @@ class Config:
 
         Unknown keys are ignored; known ones are converted to the field's type (YAML may give
         ``2`` for ``2.0``), so that a reordered or renamed field can never swap two values."""
-        kinds: dict[str, Callable[[Any], Any]] = {f.name: type(f.default) for f in fields(cls)}  # type: ignore[arg-type]
+        kinds: dict[str, Callable[[Any], Any]] = {
+            f.name: str if f.default is None else type(f.default)  # optional fields hold paths
+            for f in fields(cls)  # type: ignore[arg-type]
+        }
         return cls(**{k: kinds[k](v) for k, v in values.items() if k in kinds and v is not None})
 
     @classmethod
@@ -51,13 +54,14 @@ class InferConfig(Config):
     """Search settings of one reconstruction (``zonegraph infer``, the ``reconstruct`` stage).
 
     Args:
-        guide: proposal ranking, ``heuristic`` or ``random``.
+        guide: proposal ranking, ``heuristic``, ``random`` or an installed plugin (``net``).
         budget_s: search seconds over both graphs (zone-graph build excluded, as in the paper).
         k: proposals kept per state (top-k).
         k_decay: decrease of k per depth level (the paper's harder runs: k 15, decay 0.5).
         max_depth: longest program searched.
         seed: seed of the random guide.
         level: proposal level: sketches of 1..level and N-level..N components.
+        model: the network guide's checkpoint (None: the shipped one).
     """
 
     guide: str = "heuristic"
@@ -67,3 +71,4 @@ class InferConfig(Config):
     max_depth: int = 20
     seed: int = 0
     level: int = 1
+    model: str | None = None

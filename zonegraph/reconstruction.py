@@ -77,14 +77,19 @@ def input_unit(path: Path) -> Unit:
     return Unit.CM if path.suffix.lower() == ".json" else Unit.MM
 
 
-def _graph(solids: list[Solid], simplify: bool, source: str, saved: Path | None) -> tuple[ZoneGraph, float]:
-    """The zone graph and its build seconds; a graph saved by the pipeline is reused."""
+def _graph(
+    solids: list[Solid], simplify: bool, source: str, saved: Path | None, samples: int = 0
+) -> tuple[ZoneGraph, float]:
+    """The zone graph and its build seconds; a graph saved by the pipeline is reused.
+
+    ``samples``: surface samples per zone, for a ranker that reads zone geometry (the network)."""
     if saved is not None and (saved / "zones.parquet").is_file():
         graph = load_zone_graph(saved)
-        if graph.info.get("simplified") == simplify and graph.solids is not None:
+        usable = graph.zone_points.shape[1] >= samples
+        if graph.info.get("simplified") == simplify and graph.solids is not None and usable:
             return graph, float(graph.info["build_s"])
     t0 = time.perf_counter()
-    graph = build_zone_graph(solids, simplify=simplify, samples=0, source=source)
+    graph = build_zone_graph(solids, simplify=simplify, samples=samples, source=source)
     return graph, time.perf_counter() - t0
 
 
@@ -106,14 +111,14 @@ def reconstruct(
         ZoneGraphBuildError: no zone graph could be built.
     """
     solids = load_target(target_path)
-    ranker = make_ranker(config.guide, config.seed)
+    ranker = make_ranker(config.guide, config.seed, config.model)
     saved = Path(saved_graph) if saved_graph else None
     best: tuple[ZoneGraph, ProposalGenerator, SearchResult] | None = None
     build_s, search_s = 0.0, 0.0
     error: ZoneGraphBuildError | None = None
     for simplify in (True, False):
         try:
-            graph, seconds = _graph(solids, simplify, str(target_path), saved)
+            graph, seconds = _graph(solids, simplify, str(target_path), saved, getattr(ranker, "samples", 0))
         except ZoneGraphBuildError as exc:
             error = exc
             continue

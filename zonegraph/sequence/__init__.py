@@ -9,7 +9,14 @@ with build123d. Imports :mod:`zonegraph.zones` and :mod:`zonegraph.geometry`.
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou, build_program, execute
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
-from zonegraph.sequence.rankers import HeuristicRanker, RandomRanker, Ranker, make_ranker, zone_iou
+from zonegraph.sequence.rankers import (
+    HeuristicRanker,
+    RandomRanker,
+    Ranker,
+    make_ranker,
+    relative_rank,
+    zone_iou,
+)
 
 __all__ = [
     "HeuristicRanker",
@@ -26,6 +33,7 @@ __all__ = [
     "build_program",
     "execute",
     "make_ranker",
+    "relative_rank",
     "search",
     "zone_iou",
 ]

@@ -164,7 +164,8 @@ def label_design(
         gt: the GT steps in order, mapped onto the graph.
         design_id: seeds the design's generator together with ``seed``.
         level: proposal level (as the search).
-        multiplier: completions per remaining GT step.
+        multiplier: completions per remaining GT step; 0 runs none (rank only: the GT is positive,
+            every other proposal neutral; for ranking the GT on test designs).
         slack: completion length beyond the remaining GT steps.
 
     Returns:
@@ -211,19 +212,19 @@ def _label_step(
     assert step.op is not None
     gt_key = (np.packbits(step.zones).tobytes(), int(step.op))
     props = completer.proposals(labelled.canvas, banned)
-    runs = max(1, int(round(multiplier * remaining)))
+    runs = max(1, int(round(multiplier * remaining))) if multiplier > 0 else 0
     for p in props:
         item = LabelledProposal(p, is_gt=p.key == gt_key)
         if item.is_gt:
             item.label = POSITIVE
-        else:
+        elif runs:
             wins = sum(completer.complete(labelled.canvas, p, banned, remaining + slack) for _ in range(runs))
             item.p, item.completions = wins / runs, runs
         labelled.proposals.append(item)
     if not any(x.is_gt for x in labelled.proposals):
         labelled.reason = "GT is the inverse of an earlier GT step: the search filters it"
     others = [x for x in labelled.proposals if not x.is_gt]
-    if not others:
+    if not others or not runs:  # rank only: the GT among all proposals, no negatives
         return
     zero = [x for x in others if x.p == 0]
     for x in zero or [min(others, key=lambda x: x.p)]:

@@ -8,7 +8,9 @@ agrees with the target after the operation, ties broken by volumetric IoU.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from importlib.metadata import entry_points
 from typing import Protocol
 
 import numpy as np
@@ -65,14 +67,46 @@ class HeuristicRanker:
         return agree + iou / (graph.n_zones + 1)
 
 
-def make_ranker(guide: str, seed: int = 0) -> Ranker:
-    """The ranker a guide name stands for (``heuristic`` or ``random``, seeded).
+RANKER_PLUGINS = "zonegraph.rankers"  # entry-point group of rankers other packages provide
+
+
+def available_guides() -> list[str]:
+    """The built-in guides and those installed packages register (the network: ``net``)."""
+    return ["heuristic", "random", *sorted(e.name for e in entry_points(group=RANKER_PLUGINS))]
+
+
+def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
+    """The ranker a guide name stands for: ``heuristic``, ``random`` (seeded), or a plugin.
+
+    Plugins are entry points in the ``zonegraph.rankers`` group, called with ``model`` and
+    ``seed``: this is how ``net`` (``training.ranker:NetworkRanker``) reaches the search without
+    the core importing torch.
 
     Raises:
-        ValueError: an unknown guide.
+        ValueError: an unknown guide, or a plugin guide whose package is not installed.
     """
     if guide == "heuristic":
         return HeuristicRanker()
     if guide == "random":
         return RandomRanker(seed)
-    raise ValueError(f"unknown guide {guide!r} (heuristic or random)")
+    for entry in entry_points(group=RANKER_PLUGINS):
+        if entry.name == guide:
+            factory: Callable[..., Ranker] = entry.load()
+            return factory(model=model, seed=seed)
+    hint = (
+        " (the network guide needs the train extra: pip install 'zonegraph[train]')" if guide == "net" else ""
+    )
+    raise ValueError(f"unknown guide {guide!r}: {', '.join(available_guides())}{hint}")
+
+
+def relative_rank(scores: np.ndarray, is_gt: np.ndarray) -> float:
+    """The GT's rank among a state's proposals divided by their number (the paper's metric:
+    1/P when the GT scores highest, about 0.5 for random scores; ties count half).
+
+    Shapes:
+        scores: (P,) float, higher first; is_gt: (P,) bool with exactly one true.
+    """
+    gt = float(scores[np.flatnonzero(is_gt)[0]])
+    others = np.delete(scores, np.flatnonzero(is_gt)[0])
+    rank = 1 + float((others > gt).sum()) + 0.5 * float((others == gt).sum())
+    return rank / len(scores)

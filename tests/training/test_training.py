@@ -1,0 +1,186 @@
+"""The scorer, its data and training on labels of real samples, MLflow tracking, the network guide."""
+
+from __future__ import annotations
+
+import json
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+
+import numpy as np
+import pytest
+import torch
+from torch_geometric.loader import DataLoader
+
+from tests.conftest import requires_samples
+from training.data import LabelDataset, geometry_of, state_data
+from training.loss import focal_loss
+from training.model import ModelConfig, ProposalScorer
+from training.train import TrainConfig, forward, load_scorer, train
+from zonegraph.data.design import load_design
+from zonegraph.data.replay import replay
+from zonegraph.jobs import label_and_save
+from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.sequence.ground_truth import ground_truth
+from zonegraph.sequence.proposals import ProposalGenerator
+from zonegraph.sequence.rankers import make_ranker
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.zones.storage import save_zone_graph
+
+SAMPLES = [
+    "Couch.json",
+    "Pattern4-SteppedStartEndFace_17dd857d_0000.json",
+    "Z0HexagonCutJoin_RootComponent.json",
+]
+
+
+def test_focal_loss_is_cross_entropy_at_gamma_zero_and_discounts_easy_examples():
+    logits = torch.tensor([[2.0, -1.0], [0.1, 0.3], [-3.0, 3.0]])
+    target = torch.tensor([0, 1, 1])
+    ce = torch.nn.functional.cross_entropy(logits, target)
+    assert torch.isclose(focal_loss(logits, target, 0.0), ce)
+    assert focal_loss(logits, target, 2.0) < focal_loss(logits, target, 0.5) < ce
+
+
+@pytest.fixture(scope="module")
+def labelled(samples_dir, tmp_path_factory):
+    """Zone graphs (32 samples per zone) and labels of three real samples, as the stages write them."""
+    root = tmp_path_factory.mktemp("labelled")
+    for name in SAMPLES:
+        r = replay(load_design(samples_dir / name))
+        graph = build_zone_graph(list(r.bodies), samples=32)
+        design_id = name.split(".")[0]
+        save_zone_graph(graph, root / "graphs" / design_id)
+        gt = ground_truth(
+            graph, [s.tool.wrapped for s in r.steps], [s["operation"] for s in r.summary()["steps"]]
+        )
+        rows = [
+            {
+                "operation": s.operation,
+                "gt_zones": np.flatnonzero(s.zones).tolist(),
+                "captured": s.captured[1],
+                "reason": s.reason,
+            }
+            for s in gt.steps
+        ]
+        label_and_save(str(root / "graphs" / design_id), rows, design_id, "train", str(root / "labels"))
+    return root
+
+
+@requires_samples
+def test_both_fusions_score_and_eval_scores_do_not_depend_on_the_batch(labelled):
+    data = LabelDataset(labelled / "labels", labelled / "graphs", mode="rank", points_per_zone=16)
+    assert len(data) >= 3 and all(int(d.is_gt.sum()) == 1 for d in data)
+    state = max(data.states, key=lambda s: len(s.labels))
+    geometry = data.geometry[state.design_id]
+    canvas = torch.from_numpy(state.canvas)
+
+    def batch(rows: slice):
+        zones, ops = torch.from_numpy(state.zones[rows]), torch.from_numpy(state.ops[rows])
+        return next(iter(DataLoader([state_data(geometry, canvas, zones, ops)], batch_size=1)))
+
+    for fusion in ("late", "early"):
+        torch.manual_seed(0)
+        model = ProposalScorer(ModelConfig(fusion=fusion))
+        assert forward(model, batch(slice(None))).shape == (len(state.labels), 2)
+        model.eval()  # the original scored in training mode: a score depended on its batch
+        with torch.no_grad():
+            together = forward(model, batch(slice(None))).softmax(1)[:, 1]
+            alone = forward(model, batch(slice(0, 1))).softmax(1)[:, 1]
+        assert torch.allclose(together[0], alone[0], atol=1e-5)
+
+
+@requires_samples
+def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_path, monkeypatch, samples_dir):
+    monkeypatch.chdir(tmp_path)
+    config = TrainConfig(
+        labels_dir=str(labelled / "labels"),
+        graphs_dir=str(labelled / "graphs"),
+        out_dir="models",
+        epochs=2,
+        val_fraction=0.34,
+        points_per_zone=16,
+        batch_states=4,
+        seed=0,
+        device="cpu",
+    )
+    best = train(config)
+    metrics = json.loads((tmp_path / "models" / "metrics.json").read_text())
+    assert metrics["epoch"] == best["epoch"] and 0 < metrics["val_rank"] <= 1
+    assert (tmp_path / "models" / "curve.png").stat().st_size > 1000
+    assert load_scorer(tmp_path / "models" / "scorer.pt").training is False
+    # The run is visible through a real MLflow server's REST API.
+    port = _free_port()
+    server = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "mlflow",
+            "server",
+            "--backend-store-uri",
+            "sqlite:///mlflow.db",
+            "--host",
+            "127.0.0.1",
+            "--port",
+            str(port),
+            "--workers",
+            "1",
+        ],
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        runs = _search_runs(port)
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+    run = next(r for r in runs if r["info"]["run_id"] == metrics["run_id"])
+    names = {m["key"] for m in run["data"]["metrics"]}
+    assert {"train_loss", "val_loss", "val_rank", "best_val_rank"} <= names
+    tags = {t["key"]: t["value"] for t in run["data"]["tags"]}
+    assert len(tags["data_version"]) == 12 and tags["git_commit"]
+    # The network guide: a plugin ranker the core reaches without importing torch.
+    ranker = make_ranker("net", model=str(tmp_path / "models" / "scorer.pt"))
+    graph = build_zone_graph(list(replay(load_design(samples_dir / "Couch.json")).bodies), samples=128)
+    proposals = ProposalGenerator(graph).proposals(np.zeros(graph.n_zones, bool))
+    scores = ranker.score(graph, np.zeros(graph.n_zones, bool), proposals)
+    assert scores.shape == (len(proposals),) and ((scores >= 0) & (scores <= 1)).all()
+    result = search(graph, ranker, SearchConfig(budget_s=float("inf"), max_expansions=30))
+    assert result.expansions > 0 and result.iou > 0
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _search_runs(port: int) -> list[dict]:
+    url = f"http://127.0.0.1:{port}/api/2.0/mlflow"
+    deadline = time.time() + 120
+    while True:
+        try:
+            with urllib.request.urlopen(
+                f"{url}/experiments/get-by-name?experiment_name=zonegraph-scorer"
+            ) as r:
+                experiment = json.load(r)["experiment"]["experiment_id"]
+            body = json.dumps({"experiment_ids": [experiment]}).encode()
+            request = urllib.request.Request(
+                f"{url}/runs/search", data=body, headers={"Content-Type": "application/json"}
+            )
+            with urllib.request.urlopen(request) as r:
+                return json.load(r)["runs"]
+        except OSError:
+            if time.time() > deadline:
+                raise
+            time.sleep(1)
+
+
+def test_geometry_of_keeps_seeded_samples_and_both_edge_directions(samples_dir):
+    graph = build_zone_graph(list(replay(load_design(samples_dir / "Couch.json")).bodies), samples=64)
+    a, b = geometry_of(graph, 16, seed=1), geometry_of(graph, 16, seed=1)
+    assert a.points.shape == (graph.n_zones, 6, 16) and torch.equal(a.points, b.points)
+    assert a.edge_index.shape == (2, 2 * len(graph.edges))

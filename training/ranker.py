@@ -1,0 +1,66 @@
+"""The network guide: a trained scorer behind the search's ``Ranker`` protocol.
+
+Registered as the ``net`` entry point of the ``zonegraph.rankers`` group (``pyproject.toml``), so
+``zonegraph infer PART --guide net`` and ``make_ranker("net")`` find it while ``zonegraph/`` never
+imports torch. The model is loaded once; with late fusion a graph's zone geometry is encoded once
+and every state's proposals are scored in one batched pass, in eval mode.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch_geometric.loader import DataLoader
+
+from training.data import Geometry, geometry_of, state_data
+from training.model import ProposalScorer
+from training.train import load_scorer
+from zonegraph.sequence.proposals import Op, Proposal
+from zonegraph.zones.model import ZoneGraph
+
+SHIPPED = Path(__file__).resolve().parent / "checkpoints" / "scorer.pt"
+
+
+class NetworkRanker:
+    """Scores proposals with a trained :class:`ProposalScorer` (P(positive), higher first)."""
+
+    samples = 128  # surface samples per zone the search should build its graphs with
+
+    def __init__(self, model: str | Path | None = None, seed: int = 0, device: str = "cpu"):
+        path = Path(model) if model else SHIPPED
+        if not path.is_file():
+            raise ValueError(f"{path}: no model checkpoint (train one: python -m training.train)")
+        torch.manual_seed(seed)
+        self.device = torch.device(device)
+        self.model: ProposalScorer = load_scorer(path, device)
+        self._graph: ZoneGraph | None = None
+        self._geometry: Geometry | None = None
+        self._codes: torch.Tensor | None = None
+
+    def _prepare(self, graph: ZoneGraph) -> Geometry:
+        if graph is not self._graph or self._geometry is None:
+            self._graph, self._geometry = graph, geometry_of(graph, self.samples)
+            with torch.no_grad():
+                self._codes = self.model.encode_geometry(self._geometry.points.to(self.device))
+        return self._geometry
+
+    def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
+        """(P,) P(positive) of every proposal of one state, in one batch."""
+        if not proposals:
+            return np.zeros(0)
+        geometry = self._prepare(graph)
+        zones = torch.from_numpy(np.stack([p.zones for p in proposals]))
+        ops = torch.tensor([1 if p.op is Op.UNION else -1 for p in proposals])
+        data = state_data(geometry, torch.from_numpy(canvas.astype(bool)), zones, ops)
+        batch = next(iter(DataLoader([data], batch_size=1))).to(self.device)
+        with torch.no_grad():
+            if self.model.config.fusion == "early":
+                points = batch.points[batch.zone_of] if self.model.config.use_points else None
+                logits = self.model(batch.x, batch.edge_index, batch.proposal, points=points)
+            else:
+                logits = self.model(
+                    batch.x, batch.edge_index, batch.proposal, geometry=self._codes, zone_of=batch.zone_of
+                )
+        return logits.softmax(dim=1)[:, 1].cpu().numpy()
