@@ -1,0 +1,117 @@
+"""Milliseconds to score one search state on CPU: early vs late fusion vs the heuristic.
+
+    python -m bench.scorer_bench [--graphs data/zonegraphs/graphs] [--zones 20 100 500]
+                                 [--proposals 10 50 200] [--repeats 5] [--threads 1]
+
+For each zone count, the saved zone graph (from a pipeline run: the corpus, or the default
+synthetic data) closest to it is scored with P proposals of its own (the proposals at a few
+canvases, cycled to reach P), by an untrained scorer of each fusion (weights do not change the
+cost) and by the heuristic ranker. Late fusion's per-graph geometry encoding is timed apart: the
+search pays it once per graph, not per state. Medians of ``--repeats`` runs, one thread.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch_geometric.loader import DataLoader
+
+from training.data import geometry_of, state_data
+from training.model import ModelConfig, ProposalScorer
+from training.train import forward
+from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
+from zonegraph.sequence.rankers import HeuristicRanker
+from zonegraph.zones.model import ZoneGraph
+from zonegraph.zones.storage import load_zone_graph
+
+
+def closest_graphs(folder: Path, targets: list[int]) -> dict[int, Path]:
+    """The saved graph whose zone count is closest to each target (read from the zone tables)."""
+    import pyarrow.parquet as pq
+
+    counts = {g: pq.read_metadata(g / "zones.parquet").num_rows for g in sorted(folder.iterdir())}
+    return {t: min(counts, key=lambda g: abs(counts[g] - t)) for t in targets}
+
+
+def proposals_of(graph: ZoneGraph, count: int, seed: int = 0) -> tuple[np.ndarray, list[Proposal]]:
+    """A canvas and ``count`` proposals (cycled from those at a few random canvases)."""
+    gen, rng = ProposalGenerator(graph), np.random.default_rng(seed)
+    canvas = np.zeros(graph.n_zones, bool)
+    pool: list[Proposal] = gen.proposals(canvas)
+    while len(pool) < count and len(pool) < 5000:
+        more = gen.proposals(rng.random(graph.n_zones) < 0.5)
+        if not more and len(pool) == 0:
+            break
+        pool += more
+    pool = pool or [Proposal(0, 0, (), np.ones(graph.n_zones, bool), Op.UNION)]
+    return canvas, [pool[i % len(pool)] for i in range(count)]
+
+
+def _median_ms(fn, repeats: int) -> float:
+    fn()  # warm-up
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return 1000 * float(np.median(times))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--graphs", type=Path, default=Path("data/zonegraphs/graphs"))
+    parser.add_argument("--zones", type=int, nargs="+", default=[20, 100, 500])
+    parser.add_argument("--proposals", type=int, nargs="+", default=[10, 50, 200])
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--threads", type=int, default=1)
+    args = parser.parse_args()
+    if not args.graphs.is_dir():
+        raise SystemExit(f"{args.graphs}: no saved zone graphs (run the zonegraphs stage first)")
+    torch.set_num_threads(args.threads)
+    torch.manual_seed(0)
+    models = {f: ProposalScorer(ModelConfig(fusion=f)).eval() for f in ("early", "late")}
+    header = "| zones | proposals | early ms | late ms (+ encode) | heuristic ms | early/late | late/heur |"
+    print(header + "\n|---|---|---|---|---|---|---|")
+    for folder in closest_graphs(args.graphs, args.zones).values():
+        graph = load_zone_graph(folder, solids=False)
+        for count in args.proposals:
+            t = time_state(models, graph, count, args.repeats)
+            print(
+                f"| {graph.n_zones} | {count} | {t['early']:.1f} | {t['late']:.2f} (+{t['encode']:.1f}) | "
+                f"{t['heuristic']:.2f} | {t['early'] / t['late']:.0f}x | {t['late'] / t['heuristic']:.1f}x |",
+                flush=True,
+            )
+
+
+def time_state(
+    models: dict[str, ProposalScorer], graph: ZoneGraph, count: int, repeats: int
+) -> dict[str, float]:
+    """Median milliseconds of each way to score one state of ``graph`` with ``count`` proposals."""
+    geometry = geometry_of(graph, 128)
+    canvas, props = proposals_of(graph, count)
+    zones = torch.from_numpy(np.stack([p.zones for p in props]))
+    ops = torch.tensor([1 if p.op is Op.UNION else -1 for p in props])
+    batch = next(iter(DataLoader([state_data(geometry, torch.from_numpy(canvas), zones, ops)])))
+    late = models["late"]
+    heuristic = HeuristicRanker()
+    with torch.no_grad():
+        codes = late.encode_geometry(geometry.points)
+        return {
+            "early": _median_ms(lambda: forward(models["early"], batch), repeats),
+            "encode": _median_ms(lambda: late.encode_geometry(geometry.points), repeats),
+            "late": _median_ms(
+                lambda: late(
+                    batch.x, batch.edge_index, batch.proposal, geometry=codes, zone_of=batch.zone_of
+                ),
+                repeats,
+            ),
+            "heuristic": _median_ms(lambda: heuristic.score(graph, canvas, props), repeats),
+        }
+
+
+if __name__ == "__main__":
+    main()
