@@ -1,4 +1,4 @@
-"""Milliseconds to score one search state on CPU: early vs late fusion vs the heuristic.
+"""Milliseconds to score one search state on CPU: early, late and factored fusion vs the heuristic.
 
     python -m bench.scorer_bench [--graphs data/zonegraphs/graphs] [--zones 20 100 500]
                                  [--proposals 10 50 200] [--repeats 5] [--threads 1]
@@ -22,7 +22,6 @@ from torch_geometric.loader import DataLoader
 
 from training.data import geometry_of, state_data
 from training.model import ModelConfig, ProposalScorer
-from training.train import forward
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.sequence.rankers import HeuristicRanker
 from zonegraph.zones.model import ZoneGraph
@@ -73,16 +72,19 @@ def main() -> None:
         raise SystemExit(f"{args.graphs}: no saved zone graphs (run the zonegraphs stage first)")
     torch.set_num_threads(args.threads)
     torch.manual_seed(0)
-    models = {f: ProposalScorer(ModelConfig(fusion=f)).eval() for f in ("early", "late")}
-    header = "| zones | proposals | early ms | late ms (+ encode) | heuristic ms | early/late | late/heur |"
-    print(header + "\n|---|---|---|---|---|---|---|")
+    models = {f: ProposalScorer(ModelConfig(fusion=f)).eval() for f in ("early", "late", "factored")}
+    print(
+        "| zones | proposals | early ms | late ms | factored ms | encode ms (once per graph) | heuristic ms "
+        "| heuristic expansion ms | early/late | factored/expansion |\n" + "|---" * 10 + "|"
+    )
     for folder in closest_graphs(args.graphs, args.zones).values():
         graph = load_zone_graph(folder, solids=False)
         for count in args.proposals:
             t = time_state(models, graph, count, args.repeats)
             print(
-                f"| {graph.n_zones} | {count} | {t['early']:.1f} | {t['late']:.2f} (+{t['encode']:.1f}) | "
-                f"{t['heuristic']:.2f} | {t['early'] / t['late']:.0f}x | {t['late'] / t['heuristic']:.1f}x |",
+                f"| {graph.n_zones} | {count} | {t['early']:.1f} | {t['late']:.2f} | {t['factored']:.2f} | "
+                f"{t['encode']:.1f} | {t['heuristic']:.2f} | {t['expansion']:.2f} | "
+                f"{t['early'] / t['late']:.0f}x | {t['factored'] / t['expansion']:.1f}x |",
                 flush=True,
             )
 
@@ -90,27 +92,29 @@ def main() -> None:
 def time_state(
     models: dict[str, ProposalScorer], graph: ZoneGraph, count: int, repeats: int
 ) -> dict[str, float]:
-    """Median milliseconds of each way to score one state of ``graph`` with ``count`` proposals."""
+    """Median milliseconds of each way to score one state of ``graph`` with ``count`` proposals.
+
+    ``expansion``: what a heuristic-guided expansion costs, generating the state's proposals
+    (cold, as at a new canvas) and scoring them."""
     geometry = geometry_of(graph, 128)
     canvas, props = proposals_of(graph, count)
     zones = torch.from_numpy(np.stack([p.zones for p in props]))
     ops = torch.tensor([1 if p.op is Op.UNION else -1 for p in props])
     batch = next(iter(DataLoader([state_data(geometry, torch.from_numpy(canvas), zones, ops)])))
-    late = models["late"]
     heuristic = HeuristicRanker()
+
+    def expansion() -> None:
+        heuristic.score(graph, canvas, ProposalGenerator(graph).proposals(canvas))
+
+    out = {"heuristic": _median_ms(lambda: heuristic.score(graph, canvas, props), repeats)}
+    out["expansion"] = _median_ms(expansion, repeats)
     with torch.no_grad():
-        codes = late.encode_geometry(geometry.points)
-        return {
-            "early": _median_ms(lambda: forward(models["early"], batch), repeats),
-            "encode": _median_ms(lambda: late.encode_geometry(geometry.points), repeats),
-            "late": _median_ms(
-                lambda: late(
-                    batch.x, batch.edge_index, batch.proposal, geometry=codes, zone_of=batch.zone_of
-                ),
-                repeats,
-            ),
-            "heuristic": _median_ms(lambda: heuristic.score(graph, canvas, props), repeats),
-        }
+        out["early"] = _median_ms(lambda: models["early"](batch), repeats)
+        out["encode"] = _median_ms(lambda: models["late"].encode_geometry(geometry.points), repeats)
+        for fusion in ("late", "factored"):
+            codes = models[fusion].encode_geometry(geometry.points)
+            out[fusion] = _median_ms(lambda m=models[fusion], c=codes: m(batch, geometry=c), repeats)
+    return out
 
 
 if __name__ == "__main__":

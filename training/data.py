@@ -4,8 +4,9 @@ One example is one GT step of one design (a *state*): its canvas and a set of pr
 labels. Its graph holds one copy of the design's zones per proposal, each zone with its four
 flags (in target, in canvas, in extrusion, operation), so that PyG's batching stacks proposals and
 states alike; ``proposal`` maps zones to proposals and ``zone_of`` to rows of ``points`` (the
-design's zones, stored once per state for late fusion). Geometry is read from each saved graph
-once, when the dataset is built, keeping ``points_per_zone`` of its surface samples (seeded).
+design's zones, stored once per state, with ``zone_edge_index`` between them). Geometry is read
+from each saved graph once, when the dataset is built, keeping ``points_per_zone`` of its surface
+samples (seeded).
 """
 
 from __future__ import annotations
@@ -63,7 +64,7 @@ class StateData(Data):
     def __inc__(self, key: str, value: Tensor, *args: object, **kwargs: object) -> int:
         if key == "proposal":
             return int(self.num_proposals)
-        if key == "zone_of":
+        if key in ("zone_of", "zone_edge_index"):
             return int(self.points.shape[0])
         return super().__inc__(key, value, *args, **kwargs)
 
@@ -93,6 +94,7 @@ def state_data(geometry: Geometry, canvas: Tensor, zones: Tensor, ops: Tensor, *
         proposal=torch.arange(p).repeat_interleave(z),
         zone_of=torch.arange(z).repeat(p),
         points=geometry.points,
+        zone_edge_index=geometry.edge_index,
         num_proposals=p,
         num_nodes=p * z,
         **extra,

@@ -6,12 +6,16 @@ on the extrusion's zones). Zones carry surface samples (points and normals in th
 frame). The network scores a proposal by: a PointNet per zone, ``rounds`` of message passing over
 zone adjacency, a global max pool over zones and an MLP to two logits (negative, positive).
 
-Two ways to bring the flags in, both selectable:
+Three ways to bring the flags in, all selectable:
 
 - ``early`` (the paper): the flags are point channels (10 per point), so the PointNet runs for
   every zone of every proposal;
-- ``late`` (ours): the PointNet encodes each zone's geometry once per graph, the flags join the
-  128-d zone code after it; a state's proposals then cost only the message passing.
+- ``late``: the PointNet encodes each zone's geometry once per graph, the flags join the 128-d
+  zone code after it; a state's proposals then cost the message passing, once per proposal;
+- ``factored``: the message passing runs once per *state*, on the geometry and the state's own
+  flags (target, canvas); the extrusion flags join after it. A zone then has only three codes
+  (outside the extrusion, in a union's, in a subtraction's), computed once per state, and a
+  proposal is a masked max over them: scoring costs element-wise work per proposal, no matmul.
 
 Shapes follow PyG: zones of all proposals in a batch are stacked ((N, ...) with ``batch`` the
 proposal of each zone), ``edge_index`` (2, E) holds both directions of every adjacency.
@@ -20,6 +24,7 @@ proposal of each zone), ``edge_index`` (2, E) holds both directions of every adj
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import torch
 from torch import Tensor, nn
@@ -33,7 +38,7 @@ HIDDEN = 128
 class ModelConfig:
     """What the ablations vary: the fusion, the rounds of message passing, the point geometry."""
 
-    fusion: str = "late"  # "late" or "early"
+    fusion: str = "late"  # "early", "late" or "factored"
     rounds: int = 3
     use_points: bool = True  # False: zones are their flags only (the geometry ablation)
     hidden: int = HIDDEN
@@ -91,73 +96,80 @@ class ZoneMessages(MessagePassing):
 
 
 class ProposalScorer(nn.Module):
-    """Two logits per proposal (negative, positive); :meth:`score` gives P(positive)."""
+    """Two logits per proposal (negative, positive); :meth:`score` gives P(positive).
+
+    Reads a PyG batch of states (``training.data.StateData``): ``x`` (N, 4) flags of the N zone
+    copies (one copy of a state's zones per proposal), ``edge_index`` between them, ``proposal``
+    (N,) the proposal of each, ``zone_of`` (N,) its row of ``points`` (Z, 6, S), the states' zones
+    with ``zone_edge_index`` between them.
+    """
 
     def __init__(self, config: ModelConfig = ModelConfig()):
         super().__init__()
         self.config = config
         h = config.hidden
-        if config.fusion == "early":
-            self.encoder: nn.Module | None = PointNet(6 + FLAGS if config.use_points else FLAGS, h)
-            zone_in = h
-        elif config.fusion == "late":
-            self.encoder = PointNet(6, h) if config.use_points else None
-            zone_in = (h if config.use_points else 0) + FLAGS
+        if config.fusion not in ("early", "late", "factored"):
+            raise ValueError(f"unknown fusion {config.fusion!r} (early, late or factored)")
+        geometry_in = 6 + FLAGS if config.fusion == "early" else 6
+        self.encoder: nn.Module | None = None
+        if config.use_points:
+            self.encoder = PointNet(geometry_in, h)
+        elif config.fusion == "early":
+            self.encoder = PointNet(FLAGS, h)
+        geometry = h if config.use_points else 0
+        if config.fusion == "late":
+            self.zone_in: nn.Module = _mlp([geometry + FLAGS, h, h])
+        elif config.fusion == "factored":
+            self.zone_in = _mlp([geometry + 2, h, h])  # the state's flags: target, canvas
+            self.extrusion = _mlp([h + 3, h, h], last_plain=False)  # + one-hot: out, union, subtract
         else:
-            raise ValueError(f"unknown fusion {config.fusion!r} (early or late)")
-        self.zone_in = _mlp([zone_in, h, h]) if config.fusion == "late" else nn.Identity()
+            self.zone_in = nn.Identity()
         self.rounds = nn.ModuleList(ZoneMessages(h) for _ in range(config.rounds))
         self.readout = nn.Sequential(_mlp([h, h, h], last_plain=False), nn.Linear(h, 2))
 
     def encode_geometry(self, points: Tensor) -> Tensor | None:
-        """Late fusion's per-graph zone codes, (Z, hidden), from (Z, 6, S) points and normals."""
-        if self.config.fusion != "late" or self.encoder is None:
+        """Per-graph zone codes (late and factored fusion), (Z, hidden) from (Z, 6, S) samples."""
+        if self.config.fusion == "early" or self.encoder is None:
             return None
         return self.encoder(points)
 
-    def forward(
-        self,
-        flags: Tensor,
-        edge_index: Tensor,
-        batch: Tensor,
-        points: Tensor | None = None,
-        geometry: Tensor | None = None,
-        zone_of: Tensor | None = None,
-    ) -> Tensor:
-        """Logits (P, 2) for the P proposals of a batch.
-
-        Args:
-            flags: (N, 4) per zone of every proposal.
-            edge_index: (2, E) adjacency between those zones (both directions).
-            batch: (N,) the proposal of each zone.
-            points: early fusion: (N, 6, S) samples of each zone (repeated per proposal).
-            geometry: late fusion: (Z, hidden) zone codes of the graphs in the batch, and
-            zone_of: (N,) the row of ``geometry`` for each zone.
-        """
+    def forward(self, data: Any, geometry: Tensor | None = None) -> Tensor:
+        """Logits (P, 2) for the P proposals of a batch; ``geometry``: codes already encoded."""
+        if self.config.fusion != "early" and geometry is None:
+            geometry = self.encode_geometry(data.points)
+        if self.config.fusion == "factored":
+            return self._factored(data, geometry)
         if self.config.fusion == "early":
             if self.config.use_points:
-                assert points is not None
-                channels = flags[:, :, None].expand(-1, -1, points.shape[2])
-                x = self.encoder(torch.cat([points, channels], dim=1))  # type: ignore[misc]
+                channels = data.x[:, :, None].expand(-1, -1, data.points.shape[2])
+                x = self.encoder(torch.cat([data.points[data.zone_of], channels], dim=1))  # type: ignore[misc]
             else:
-                x = self.encoder(flags[:, :, None])  # type: ignore[misc]
+                x = self.encoder(data.x[:, :, None])  # type: ignore[misc]
         else:
-            parts = [flags]
-            if self.config.use_points:
-                assert geometry is not None and zone_of is not None
-                parts.insert(0, geometry[zone_of])
+            parts = [data.x] if geometry is None else [geometry[data.zone_of], data.x]
             x = self.zone_in(torch.cat(parts, dim=1))
         for layer in self.rounds:
-            x = layer(x, edge_index)
-        return self.readout(global_max_pool(x, batch))
+            x = layer(x, data.edge_index)
+        return self.readout(global_max_pool(x, data.proposal))
+
+    def _factored(self, data: Any, geometry: Tensor | None) -> Tensor:
+        state_flags = torch.zeros(data.points.shape[0], 2, device=data.x.device)
+        state_flags[data.zone_of] = data.x[:, :2]  # the same in every copy of a state's zone
+        x = self.zone_in(state_flags if geometry is None else torch.cat([geometry, state_flags], dim=1))
+        for layer in self.rounds:
+            x = layer(x, data.zone_edge_index)
+        kinds = torch.eye(3, device=x.device)
+        codes = torch.stack([self.extrusion(torch.cat([x, k.expand(len(x), 3)], dim=1)) for k in kinds])
+        kind = (data.x[:, 2] * torch.where(data.x[:, 3] < 0, 2.0, 1.0)).long()  # 0 out, 1 union, 2 subtract
+        return self.readout(global_max_pool(codes[kind, data.zone_of], data.proposal))
 
     @torch.no_grad()
-    def score(self, *args: Tensor | None, **kwargs: Tensor | None) -> Tensor:
+    def score(self, data: Any, geometry: Tensor | None = None) -> Tensor:
         """P(positive) per proposal, in eval mode (the original scored with BatchNorm in training
         mode, so a proposal's score depended on the others batched with it)."""
         was_training = self.training
         self.eval()
         try:
-            return self.forward(*args, **kwargs).softmax(dim=1)[:, 1]  # type: ignore[arg-type]
+            return self.forward(data, geometry).softmax(dim=1)[:, 1]
         finally:
             self.train(was_training)

@@ -56,11 +56,5 @@ class NetworkRanker:
         data = state_data(geometry, torch.from_numpy(canvas.astype(bool)), zones, ops)
         batch = next(iter(DataLoader([data], batch_size=1))).to(self.device)
         with torch.no_grad():
-            if self.model.config.fusion == "early":
-                points = batch.points[batch.zone_of] if self.model.config.use_points else None
-                logits = self.model(batch.x, batch.edge_index, batch.proposal, points=points)
-            else:
-                logits = self.model(
-                    batch.x, batch.edge_index, batch.proposal, geometry=self._codes, zone_of=batch.zone_of
-                )
+            logits = self.model(batch, geometry=self._codes)
         return logits.softmax(dim=1)[:, 1].cpu().numpy()

@@ -79,12 +79,8 @@ def pick_device(name: str) -> torch.device:
 
 
 def forward(model: ProposalScorer, batch: Any) -> torch.Tensor:
-    """Logits (P, 2) for a PyG batch of states, in either fusion."""
-    if model.config.fusion == "early":
-        points = batch.points[batch.zone_of] if model.config.use_points else None
-        return model(batch.x, batch.edge_index, batch.proposal, points=points)
-    geometry = model.encode_geometry(batch.points)
-    return model(batch.x, batch.edge_index, batch.proposal, geometry=geometry, zone_of=batch.zone_of)
+    """Logits (P, 2) for a PyG batch of states, in any fusion."""
+    return model(batch)
 
 
 def mean_loss(model: ProposalScorer, loader: DataLoader, device: torch.device, gamma: float) -> float:

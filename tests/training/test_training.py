@@ -81,7 +81,7 @@ def test_both_fusions_score_and_eval_scores_do_not_depend_on_the_batch(labelled)
         zones, ops = torch.from_numpy(state.zones[rows]), torch.from_numpy(state.ops[rows])
         return next(iter(DataLoader([state_data(geometry, canvas, zones, ops)], batch_size=1)))
 
-    for fusion in ("late", "early"):
+    for fusion in ("late", "early", "factored"):
         torch.manual_seed(0)
         model = ProposalScorer(ModelConfig(fusion=fusion))
         assert forward(model, batch(slice(None))).shape == (len(state.labels), 2)
