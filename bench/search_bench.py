@@ -46,6 +46,8 @@ def run(name: str, designs, budget: float, guide: str, max_zones: int) -> None:
         f"\n{name} ({guide}, budget {budget:g} s): {len(per_design)} designs searched, {exact} exact, "
         f"{len(t)} expansions"
     )
+    if not len(t):  # nothing searched (e.g. --synthetic 0)
+        return
     print(f"  proposals per state  median {np.median(p):.0f}  p90 {np.percentile(p, 90):.0f}  max {p.max()}")
     print(
         f"  ms per expansion     median {np.median(t):.2f}  p90 {np.percentile(t, 90):.2f}  max {t.max():.1f}"
