@@ -17,17 +17,15 @@ from __future__ import annotations
 import argparse
 import json
 import tempfile
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
+from bench.corpus import CORPUS, require_corpus, run_designs, write_results
 from zonegraph.configs import InferConfig
 from zonegraph.data.b123d import CorpusEntry, convert_design, list_corpus
 from zonegraph.isolation import run_isolated
 from zonegraph.reconstruction import infer
-
-CORPUS = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_b123d"
 
 
 def sample(corpus: Path, per_folder: int, seed: int) -> list[CorpusEntry]:
@@ -100,23 +98,15 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", type=Path, default=Path("bench_out/corpus"))
     args = parser.parse_args()
-    if not args.corpus.is_dir():
-        raise SystemExit(f"corpus not found at {args.corpus} (clone Fusion360GalleryDataset-build123d there)")
+    require_corpus(args.corpus)
     entries = sample(args.corpus, args.per_folder, args.seed)
     print(f"{len(entries)} designs, heuristic, budget {args.budget:g} s, {args.workers} workers", flush=True)
-    rows = []
-    with tempfile.TemporaryDirectory() as work, ProcessPoolExecutor(args.workers) as pool:
+    with tempfile.TemporaryDirectory() as work:
         jobs = [(e, args.budget, work) for e in entries]
-        for i, row in enumerate(pool.map(_job, jobs), 1):
-            rows.append(row)
-            if i % 10 == 0 or i == len(jobs):
-                done = sum(bool(r.get("exact")) for r in rows)
-                print(f"  {i}/{len(jobs)} designs, {done} exact", flush=True)
-    table = summarise(rows)
-    print(table)
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
-    (args.out / "results.md").write_text(table + "\n")
+        rows = run_designs(
+            _job, jobs, args.workers, lambda rs: f", {sum(bool(r.get('exact')) for r in rs)} exact"
+        )
+    write_results(rows, summarise(rows), args.out)
 
 
 if __name__ == "__main__":

@@ -21,11 +21,11 @@ import argparse
 import json
 import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
+from bench.corpus import CORPUS, require_corpus, run_designs, write_results
 from zonegraph.data.b123d import CorpusEntry, convert_design, list_corpus
 from zonegraph.data.dataset import stratified_sample, test_ids
 from zonegraph.data.design import load_design
@@ -35,7 +35,6 @@ from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.labels import NEGATIVE, NEUTRAL, POSITIVE, GTOperation, label_design
 from zonegraph.zones.build import build_zone_graph
 
-CORPUS = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_b123d"
 CORPUS_SIZE, CLUSTER_CORES = 7483, 16
 
 
@@ -164,26 +163,16 @@ def main() -> None:
     parser.add_argument("--slack", type=int, default=2)
     parser.add_argument("--out", type=Path, default=Path("bench_out/labels"))
     args = parser.parse_args()
-    if not args.corpus.is_dir():
-        raise SystemExit(f"corpus not found at {args.corpus} (clone Fusion360GalleryDataset-build123d there)")
+    require_corpus(args.corpus)
     entries = training_sample(args.corpus, args.designs, args.seed)
     population: dict[str, int] = {}
     for e in list_corpus(args.corpus):
         population[e.folder] = population.get(e.folder, 0) + 1
     print(f"{len(entries)} training designs, {args.workers} workers, timeout {args.timeout:g} s", flush=True)
     settings = (args.seed, args.level, args.multiplier, args.slack)
-    rows = []
-    with tempfile.TemporaryDirectory() as work, ProcessPoolExecutor(args.workers) as pool:
-        jobs = [(e, work, args.timeout, *settings) for e in entries]
-        for i, row in enumerate(pool.map(_job, jobs), 1):
-            rows.append(row)
-            if i % 10 == 0 or i == len(jobs):
-                print(f"  {i}/{len(jobs)} designs", flush=True)
-    table = summarise(rows, args.timeout, population)
-    print(table)
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
-    (args.out / "results.md").write_text(table + "\n")
+    with tempfile.TemporaryDirectory() as work:
+        rows = run_designs(_job, [(e, work, args.timeout, *settings) for e in entries], args.workers)
+    write_results(rows, summarise(rows, args.timeout, population), args.out)
 
 
 if __name__ == "__main__":

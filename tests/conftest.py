@@ -22,3 +22,18 @@ def samples_dir() -> Path:
 
 
 requires_samples = pytest.mark.skipif(not SAMPLES.is_dir(), reason=SKIP_REASON)
+
+
+def gt_rows(steps, level: int = 1) -> list[dict]:
+    """The ground-truth stage's per-step rows (what the labels stage reads) of ``GTStep`` objects."""
+    import numpy as np
+
+    return [
+        {
+            "operation": s.operation,
+            "gt_zones": np.flatnonzero(s.zones).tolist(),
+            "captured": s.captured[level],
+            "reason": s.reason,
+        }
+        for s in steps
+    ]

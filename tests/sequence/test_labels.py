@@ -8,7 +8,7 @@ import pyarrow.parquet as pq
 import pytest
 from build123d import Box, Cylinder, Pos
 
-from tests.conftest import requires_samples
+from tests.conftest import gt_rows, requires_samples
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.jobs import label_and_save
@@ -121,15 +121,7 @@ def test_real_samples_keep_the_invariants_and_write_readable_shards(samples_dir,
     operations = [s["operation"] for s in r.summary()["steps"]]
     gt = ground_truth(graph, [s.tool.wrapped for s in r.steps], operations)
     save_zone_graph(graph, tmp_path / "graph")
-    rows = [
-        {
-            "operation": s.operation,
-            "gt_zones": np.flatnonzero(s.zones).tolist(),
-            "captured": s.captured[1],
-            "reason": s.reason,
-        }
-        for s in gt.steps
-    ]
+    rows = gt_rows(gt.steps)
     counts = label_and_save(str(tmp_path / "graph"), rows, "sample", "train", str(tmp_path / "labels"))
     proposals = pq.read_table(tmp_path / "labels" / "proposals" / "sample.parquet")
     steps = pq.read_table(tmp_path / "labels" / "steps" / "sample.parquet")

@@ -14,7 +14,7 @@ import pytest
 import torch
 from torch_geometric.loader import DataLoader
 
-from tests.conftest import requires_samples
+from tests.conftest import gt_rows, requires_samples
 from training.data import LabelDataset, geometry_of, state_data
 from training.loss import focal_loss
 from training.model import ModelConfig, ProposalScorer
@@ -56,15 +56,7 @@ def labelled(samples_dir, tmp_path_factory):
         gt = ground_truth(
             graph, [s.tool.wrapped for s in r.steps], [s["operation"] for s in r.summary()["steps"]]
         )
-        rows = [
-            {
-                "operation": s.operation,
-                "gt_zones": np.flatnonzero(s.zones).tolist(),
-                "captured": s.captured[1],
-                "reason": s.reason,
-            }
-            for s in gt.steps
-        ]
+        rows = gt_rows(gt.steps)
         label_and_save(str(root / "graphs" / design_id), rows, design_id, "train", str(root / "labels"))
     return root
 
