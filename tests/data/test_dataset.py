@@ -22,7 +22,12 @@ def test_official_split_file_one_level_up(tmp_path):
     folder = make_folder(tmp_path, 4)
     (tmp_path / "train_test.json").write_text(json.dumps({"train": ["d00", "d01", "d02"], "test": ["d03"]}))
     records = read_dataset(folder)
-    assert [(r.design_id, r.split) for r in records] == [("d00", "train"), ("d01", "train"), ("d02", "train"), ("d03", "test")]
+    assert [(r.design_id, r.split) for r in records] == [
+        ("d00", "train"),
+        ("d01", "train"),
+        ("d02", "train"),
+        ("d03", "test"),
+    ]
 
 
 def test_seeded_split_is_reproducible(tmp_path):

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import pytest
 
+from tests import fusion_json as fj
 from zonegraph.cli import main
 from zonegraph.data.design import load_design
-from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError
 from zonegraph.data.replay import replay
-
-from tests import fusion_json as fj
+from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError
 
 
 def replay_file(path):
@@ -62,10 +61,13 @@ def test_timeline_entity_missing(tmp_path):
         replay_file(fj.write(tmp_path, data))
 
 
-@pytest.mark.parametrize("field, value, message", [
-    ("extent_type", "AllExtentType", "unsupported extent type"),
-    ("operation", "NewComponentFeatureOperation", "unsupported operation"),
-])
+@pytest.mark.parametrize(
+    "field, value, message",
+    [
+        ("extent_type", "AllExtentType", "unsupported extent type"),
+        ("operation", "NewComponentFeatureOperation", "unsupported operation"),
+    ],
+)
 def test_unsupported_feature(tmp_path, field, value, message):
     data = square_design()
     data["entities"]["e1"][field] = value

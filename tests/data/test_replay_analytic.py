@@ -7,10 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from tests import fusion_json as fj
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
-
-from tests import fusion_json as fj
 
 SQUARE = [(True, fj.rect(0, 0, 2, 2))]  # area 4
 
@@ -37,8 +36,16 @@ def z_range(result):
         ("OneSideFeatureExtentType", fj.extent(2.0), None, 1.0, (1.0, 3.0)),
         ("SymmetricFeatureExtentType", fj.extent(1.0, full=False), None, -0.5, (-1.5, 0.5)),
     ],
-    ids=["one-side", "one-side-negative", "two-sides", "two-sides-same-side", "symmetric-full",
-         "symmetric-half", "offset-start", "symmetric-offset"],
+    ids=[
+        "one-side",
+        "one-side-negative",
+        "two-sides",
+        "two-sides-same-side",
+        "symmetric-full",
+        "symmetric-half",
+        "offset-start",
+        "symmetric-offset",
+    ],
 )
 def test_extent_intervals(tmp_path, kind, one, two, offset, expected):
     result = run(tmp_path, fj.sketch(SQUARE), fj.extrude("s0", kind=kind, one=one, two=two, offset=offset))
@@ -66,13 +73,17 @@ def test_taper_on_negative_direction(tmp_path):
 def test_arc_over_180_degrees_keeps_the_major_segment(tmp_path):
     sweep = 1.5 * math.pi
     a = fj.arc((0, 0), 1.0, -sweep / 2, sweep / 2)
-    chord = fj.line((a["end_point"]["x"], a["end_point"]["y"]), (a["start_point"]["x"], a["start_point"]["y"]))
+    chord = fj.line(
+        (a["end_point"]["x"], a["end_point"]["y"]), (a["start_point"]["x"], a["start_point"]["y"])
+    )
     result = run(tmp_path, fj.sketch([(True, [chord, a])]), fj.extrude("s0", one=fj.extent(1.0)))
     assert result.volume == pytest.approx((sweep - math.sin(sweep)) / 2, rel=1e-9)
 
 
 def test_ellipse_profile(tmp_path):
-    result = run(tmp_path, fj.sketch([(True, [fj.ellipse((1, 1), 2.0, 0.5)])]), fj.extrude("s0", one=fj.extent(2.0)))
+    result = run(
+        tmp_path, fj.sketch([(True, [fj.ellipse((1, 1), 2.0, 0.5)])]), fj.extrude("s0", one=fj.extent(2.0))
+    )
     assert result.volume == pytest.approx(2 * math.pi * 2.0 * 0.5, rel=1e-7)
 
 
@@ -92,7 +103,9 @@ def test_rotated_sketch_frame_places_the_solid(tmp_path):
     z /= np.linalg.norm(z)
     y = np.cross(z, x)
     frame = {"origin": (1.0, -2.0, 3.0), "x_axis": tuple(x), "y_axis": tuple(y), "z_axis": tuple(z)}
-    result = run(tmp_path, fj.sketch([(True, fj.rect(0, 0, 2, 1))], frame), fj.extrude("s0", one=fj.extent(0.5)))
+    result = run(
+        tmp_path, fj.sketch([(True, fj.rect(0, 0, 2, 1))], frame), fj.extrude("s0", one=fj.extent(0.5))
+    )
     expected = np.array([1.0, -2.0, 3.0]) + x * 1.0 + y * 0.5 + z * 0.25  # centre of the 2 x 1 x 0.5 box
     assert np.allclose(tuple(result.shape.center()), expected, atol=1e-9)
     assert result.volume == pytest.approx(1.0, rel=1e-9)
@@ -114,8 +127,10 @@ def test_inner_loop_makes_a_hole(tmp_path):
 def test_shuffled_and_reversed_loop_edges_still_close(tmp_path):
     edges = fj.rect(0, 0, 2, 2)
     first = edges[0]
-    reversed_first = fj.line((first["end_point"]["x"], first["end_point"]["y"]),
-                             (first["start_point"]["x"], first["start_point"]["y"]))
+    reversed_first = fj.line(
+        (first["end_point"]["x"], first["end_point"]["y"]),
+        (first["start_point"]["x"], first["start_point"]["y"]),
+    )
     loop = [edges[2], reversed_first, edges[3], edges[1]]
     result = run(tmp_path, fj.sketch([(True, loop)]), fj.extrude("s0", one=fj.extent(1.0)))
     assert result.volume == pytest.approx(4.0, rel=1e-9)

@@ -6,8 +6,8 @@ import json
 from multiprocessing import get_context
 
 from zonegraph.data.design import parse_design
-from zonegraph.data.stats import design_statistics
 from zonegraph.data.replay import replay
+from zonegraph.data.stats import design_statistics
 from zonegraph.data.synthetic import generate_design
 
 COUNT = 500  # the bar: 500 designs replay with no failure
@@ -29,7 +29,7 @@ def check_design(i: int) -> tuple[str, str]:
     if abs(result.volume - props.volume) > 1e-9 * props.volume or result.face_count != props.face_count:
         problems.append("properties differ")
     volumes = [0.0] + [s.volume for s in result.steps]
-    if any(abs(b - a) <= 1e-3 * max(a, b) for a, b in zip(volumes, volumes[1:])):
+    if any(abs(b - a) <= 1e-3 * max(a, b) for a, b in zip(volumes, volumes[1:], strict=False)):
         problems.append("a step leaves the shape unchanged")
     for s in result.steps:
         if (s.body_count, s.face_count) != (s.extrude.labels.body_count, s.extrude.labels.face_count):

@@ -104,7 +104,9 @@ EXTENT_RE = re.compile(r"^\s*#\s*(OneSide|Symmetric|TwoSides)\b.*extrude")
 FULL_LENGTH_RE = re.compile(r"full_length\s*=\s*True")
 
 OPERATIONS = {
-    "NewBody": Operation.NEW_BODY, "Join": Operation.JOIN, "Cut": Operation.CUT,
+    "NewBody": Operation.NEW_BODY,
+    "Join": Operation.JOIN,
+    "Cut": Operation.CUT,
     "Intersect": Operation.INTERSECT,
 }
 SHORT_NAMES = {v: k for k, v in OPERATIONS.items()}
@@ -155,20 +157,24 @@ def _batch_entries(batch: Path, folder: str) -> list[CorpusEntry]:
     measures: dict[str, tuple[float | None, float | None]] = {}
     m = re.search(r"^MODELS\s*=", text, flags=re.M)
     if m:
-        tail = text[m.start():]
+        tail = text[m.start() :]
         stop = re.search(r"^if __name__", tail, flags=re.M)
         with contextlib.suppress(SyntaxError, ValueError):
             measures = _models_measures(ast.parse(tail[: stop.start()] if stop else tail))
-    return [CorpusEntry(n.removeprefix("model_"), folder, str(batch), n, *measures.get(n, (None, None)))
-            for n in names]
+    return [
+        CorpusEntry(n.removeprefix("model_"), folder, str(batch), n, *measures.get(n, (None, None)))
+        for n in names
+    ]
 
 
 def _models_measures(tree: ast.Module) -> dict[str, tuple[float | None, float | None]]:
     """``MODELS`` -> {function: (volume, area)} from the literal dict (its ``func`` is a name)."""
     out: dict[str, tuple[float | None, float | None]] = {}
     for node in tree.body:
-        if not (isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "MODELS"
-                                                     for t in node.targets)):
+        if not (
+            isinstance(node, ast.Assign)
+            and any(isinstance(t, ast.Name) and t.id == "MODELS" for t in node.targets)
+        ):
             continue
         if not isinstance(node.value, ast.Dict):
             continue
@@ -179,8 +185,11 @@ def _models_measures(tree: ast.Module) -> dict[str, tuple[float | None, float | 
                 continue
             fields: dict[str, float] = {}
             for k, v in zip(value.keys, value.values, strict=True):
-                if isinstance(k, ast.Constant) and isinstance(v, ast.Constant) \
-                        and isinstance(v.value, (int, float)):
+                if (
+                    isinstance(k, ast.Constant)
+                    and isinstance(v, ast.Constant)
+                    and isinstance(v.value, (int, float))
+                ):
                     fields[str(k.value)] = float(v.value)
             out[key.value] = (fields.get("volume"), fields.get("area"))
     return out
@@ -259,8 +268,9 @@ def load_batch(batch_path: str | Path) -> _Batch:
         text = Path(key).read_text(encoding="utf-8")
         lines = text.splitlines()
         tree = ast.parse(text, filename=key)
-        spans = {n.name: (n.lineno, n.end_lineno or n.lineno)
-                 for n in tree.body if isinstance(n, ast.FunctionDef)}
+        spans = {
+            n.name: (n.lineno, n.end_lineno or n.lineno) for n in tree.body if isinstance(n, ast.FunctionDef)
+        }
         install_ocp_shims()
         name = "zonegraph_b123d_" + hashlib.sha1(key.encode()).hexdigest()[:16]
         spec = importlib.util.spec_from_file_location(name, key)
@@ -297,16 +307,30 @@ def _install_api_shims(module: types.ModuleType) -> None:
     if original is None or "end_angle" in inspect.signature(original).parameters:
         return
 
-    def elliptical_center_arc(center: Any, x_radius: float, y_radius: float, start_angle: float = 0.0,
-                              end_angle: float | None = None, rotation: float = 0.0,
-                              angular_direction: Any = None, **kwargs: Any) -> Any:
+    def elliptical_center_arc(
+        center: Any,
+        x_radius: float,
+        y_radius: float,
+        start_angle: float = 0.0,
+        end_angle: float | None = None,
+        rotation: float = 0.0,
+        angular_direction: Any = None,
+        **kwargs: Any,
+    ) -> Any:
         if end_angle is None:  # new-style call
             return original(center, x_radius, y_radius, start_angle, rotation=rotation, **kwargs)
         clockwise = getattr(angular_direction, "name", "") == "CLOCKWISE"
         sweep = (start_angle - end_angle) % 360 if clockwise else (end_angle - start_angle) % 360
         sweep = sweep or 360.0
-        return original(center, x_radius, y_radius, start_angle, arc_size=-sweep if clockwise else sweep,
-                        rotation=rotation, **kwargs)
+        return original(
+            center,
+            x_radius,
+            y_radius,
+            start_angle,
+            arc_size=-sweep if clockwise else sweep,
+            rotation=rotation,
+            **kwargs,
+        )
 
     module.EllipticalCenterArc = elliptical_center_arc  # type: ignore[attr-defined]
 
@@ -344,15 +368,24 @@ class RecordedCall:
 def _recording_extrude(real: Callable[..., Any], path: str) -> Callable[..., Any]:
     """A drop-in ``extrude`` that records its faces and arguments, then runs the real one."""
 
-    def extrude(to_extrude: Any = None, amount: float | None = None, dir: Any = None,  # noqa: A002
-                until: Any = None, target: Any = None, both: bool = False, taper: float = 0.0,
-                clean: bool = True, mode: Any = None) -> Any:
+    def extrude(
+        to_extrude: Any = None,
+        amount: float | None = None,
+        dir: Any = None,  # noqa: A002
+        until: Any = None,
+        target: Any = None,
+        both: bool = False,
+        taper: float = 0.0,
+        clean: bool = True,
+        mode: Any = None,
+    ) -> Any:
         if _ACTIVE:
             frame = sys._getframe(1)
             line = frame.f_lineno if frame.f_code.co_filename == path else -1
             _ACTIVE[-1].append(_record(to_extrude, amount, dir, until, both, taper, mode, line))
-        kwargs: dict[str, Any] = dict(amount=amount, dir=dir, until=until, target=target, both=both,
-                                      taper=taper, clean=clean)
+        kwargs: dict[str, Any] = dict(
+            amount=amount, dir=dir, until=until, target=target, both=both, taper=taper, clean=clean
+        )
         if mode is not None:
             kwargs["mode"] = mode
         return real(to_extrude, **kwargs)
@@ -360,14 +393,28 @@ def _recording_extrude(real: Callable[..., Any], path: str) -> Callable[..., Any
     return extrude
 
 
-def _record(to_extrude: Any, amount: float | None, direction: Any, until: Any, both: bool, taper: float,
-            mode: Any, line: int) -> RecordedCall:
+def _record(
+    to_extrude: Any,
+    amount: float | None,
+    direction: Any,
+    until: Any,
+    both: bool,
+    taper: float,
+    mode: Any,
+    line: int,
+) -> RecordedCall:
     """Snapshot the faces ``extrude`` is about to consume (it clears the pending list itself)."""
     from build123d import BuildPart, Plane
 
     mode_name = "ADD" if mode is None else str(getattr(mode, "name", mode))
-    base = dict(line=line, amount=float(amount or 0.0), both=bool(both), taper=float(taper or 0.0),
-                mode=mode_name, explicit=to_extrude is not None)
+    base = dict(
+        line=line,
+        amount=float(amount or 0.0),
+        both=bool(both),
+        taper=float(taper or 0.0),
+        mode=mode_name,
+        explicit=to_extrude is not None,
+    )
     try:
         if amount is None or until is not None or direction is not None:
             raise UnsupportedFeatureError("", None, "extrude with until/dir (only distances)")
@@ -384,8 +431,8 @@ def _record(to_extrude: Any, amount: float | None, direction: Any, until: Any, b
     except UnsupportedFeatureError as exc:
         return RecordedCall(faces=(), error=exc.reason, **base)  # type: ignore[arg-type]
     except Exception as exc:  # a face we cannot read: say why, let the real extrude run
-        return RecordedCall(faces=(), error=f"cannot read profile: {type(exc).__name__}: {_short(exc)}",
-                            **base)  # type: ignore[arg-type]
+        reason = f"cannot read profile: {type(exc).__name__}: {_short(exc)}"
+        return RecordedCall(faces=(), error=reason, **base)  # type: ignore[arg-type]
 
 
 @contextlib.contextmanager
@@ -447,8 +494,15 @@ def face_record(face: Any, plane: Any) -> RecordedFace:
         dropped += len(curves) - len(kept)
         loops.append(Loop(outer, tuple(kept)))
     normal = _v3(plane.z_dir)
-    return RecordedFace(local.frame, tuple(loops), face_area(face), _t(_v3(face.center())),
-                        _t(normal / np.linalg.norm(normal)), float(face.area), dropped)
+    return RecordedFace(
+        local.frame,
+        tuple(loops),
+        face_area(face),
+        _t(_v3(face.center())),
+        _t(normal / np.linalg.norm(normal)),
+        float(face.area),
+        dropped,
+    )
 
 
 def face_area(face: Any) -> float | None:
@@ -488,13 +542,26 @@ def edge_curve(edge: Any, local: _Local) -> Curve:
         center, normal = local.point(_v3(ax.Location())), local.vector(_v3(ax.Direction()))
         if abs((last - f) - 2 * math.pi) < 1e-9:
             return Circle(center, circ.Radius(), normal)
-        return Arc(local.point(_v3(ad.Value(f))), local.point(_v3(ad.Value(last))), center, circ.Radius(),
-                   normal, f, last, local.vector(_v3(ax.XDirection())))
+        return Arc(
+            local.point(_v3(ad.Value(f))),
+            local.point(_v3(ad.Value(last))),
+            center,
+            circ.Radius(),
+            normal,
+            f,
+            last,
+            local.vector(_v3(ax.XDirection())),
+        )
     if kind == GeomAbs_Ellipse:
         el = ad.Ellipse()
         ax = el.Position()
-        common = (local.point(_v3(ax.Location())), local.vector(_v3(ax.XDirection())), el.MajorRadius(),
-                  el.MinorRadius(), local.vector(_v3(ax.Direction())))
+        common = (
+            local.point(_v3(ax.Location())),
+            local.vector(_v3(ax.XDirection())),
+            el.MajorRadius(),
+            el.MinorRadius(),
+            local.vector(_v3(ax.Direction())),
+        )
         if abs((last - f) - 2 * math.pi) < 1e-9:
             return Ellipse(*common)
         return EllipticalArc(*common, f, last)
@@ -592,8 +659,10 @@ class _Writer:
 
 
 def _same_frame(a: Frame, b: Frame) -> bool:
-    return all(np.allclose(u, v, atol=1e-12) for u, v in
-               ((a.origin, b.origin), (a.x_axis, b.x_axis), (a.z_axis, b.z_axis)))
+    return all(
+        np.allclose(u, v, atol=1e-12)
+        for u, v in ((a.origin, b.origin), (a.x_axis, b.x_axis), (a.z_axis, b.z_axis))
+    )
 
 
 def _fusion_taper(degrees: float) -> float:
@@ -606,10 +675,12 @@ def _single_extent(call: RecordedCall, full_length: bool) -> dict[str, Any]:
     if call.both:
         d = abs(call.amount)
         if full_length:
-            return dict(extent_type=ExtentType.SYMMETRIC, extent_one=Extent(2 * d, taper),
-                        symmetric_full_length=True)
-        return dict(extent_type=ExtentType.SYMMETRIC, extent_one=Extent(d, taper),
-                    symmetric_full_length=False)
+            return dict(
+                extent_type=ExtentType.SYMMETRIC, extent_one=Extent(2 * d, taper), symmetric_full_length=True
+            )
+        return dict(
+            extent_type=ExtentType.SYMMETRIC, extent_one=Extent(d, taper), symmetric_full_length=False
+        )
     return dict(extent_type=ExtentType.ONE_SIDE, extent_one=Extent(call.amount, taper))
 
 
@@ -620,8 +691,10 @@ def _along(first: RecordedCall, second: RecordedCall) -> float | None:
     sign = 0.0
     for a, b in zip(first.faces, second.faces, strict=True):
         scale = max(math.sqrt(a.quick_area), 1e-9)
-        if abs(a.quick_area - b.quick_area) > SAME_TOL * max(a.quick_area, 1e-12) or \
-                np.linalg.norm(np.subtract(a.center, b.center)) > SAME_TOL * 1e3 * scale:
+        if (
+            abs(a.quick_area - b.quick_area) > SAME_TOL * max(a.quick_area, 1e-12)
+            or np.linalg.norm(np.subtract(a.center, b.center)) > SAME_TOL * 1e3 * scale
+        ):
             return None
         dot = float(np.dot(a.normal, b.normal))
         if abs(abs(dot) - 1) > 1e-9 or (sign and sign != math.copysign(1.0, dot)):
@@ -646,13 +719,21 @@ def merge_pair(first: RecordedCall, second: RecordedCall) -> dict[str, Any] | No
     a = first.amount
     if first.mode == second.mode and first.mode in ("ADD", "SUBTRACT"):
         if a * b < 0:
-            return dict(extent_type=ExtentType.TWO_SIDES, extent_one=Extent(a, _fusion_taper(first.taper)),
-                        extent_two=Extent(-b, _fusion_taper(second.taper)))
+            return dict(
+                extent_type=ExtentType.TWO_SIDES,
+                extent_one=Extent(a, _fusion_taper(first.taper)),
+                extent_two=Extent(-b, _fusion_taper(second.taper)),
+            )
         if first.taper == 0 and second.taper == 0:  # one side twice: the longer one wins
             return dict(extent_type=ExtentType.ONE_SIDE, extent_one=Extent(a if abs(a) >= abs(b) else b))
         return None
-    if (first.mode, second.mode) == ("ADD", "SUBTRACT") and a * b > 0 and abs(b) < abs(a) \
-            and first.taper == 0 and second.taper == 0:
+    if (
+        (first.mode, second.mode) == ("ADD", "SUBTRACT")
+        and a * b > 0
+        and abs(b) < abs(a)
+        and first.taper == 0
+        and second.taper == 0
+    ):
         return dict(extent_type=ExtentType.TWO_SIDES, extent_one=Extent(a), extent_two=Extent(-b))
     return None
 
@@ -699,8 +780,7 @@ def build_design(design_id: str, features: list[_Feature], literal: bool = False
         extent = merge_pair(calls[0], calls[1]) if len(calls) == 2 and not literal else None
         if len(calls) == 1 or extent is not None:
             refs = w.sketches(calls[0], sketch_name)
-            w.extrude(refs, name, first_op,
-                      **(extent or _single_extent(calls[0], bool(c and c.full_length))))
+            w.extrude(refs, name, first_op, **(extent or _single_extent(calls[0], bool(c and c.full_length))))
             ops.append(SHORT_NAMES[first_op])
             continue
         notes.append(f"{name}: {len(calls)} calls written as {len(calls)} extrudes")
@@ -790,8 +870,13 @@ def _folder_of(path: Path) -> str:
     return path.parent.name
 
 
-def convert_design(batch_path: str | Path, design_id: str, fusion_volume: float | None = None,
-                   fusion_area: float | None = None, timeout_s: float | None = None) -> ConvertedDesign:
+def convert_design(
+    batch_path: str | Path,
+    design_id: str,
+    fusion_volume: float | None = None,
+    fusion_area: float | None = None,
+    timeout_s: float | None = None,
+) -> ConvertedDesign:
     """Run ``model_<design_id>`` of a batch, convert its extrudes to our JSON and verify the replay.
 
     Fusion's volume/area default to the batch's ``MODELS`` entry. Never raises for a bad design.
@@ -801,8 +886,15 @@ def convert_design(batch_path: str | Path, design_id: str, fusion_volume: float 
     folder = _folder_of(path)
 
     def result(status: str, reason: str, **kw: Any) -> ConvertedDesign:
-        return ConvertedDesign(design_id, folder, kw.pop("design_json", None), status, reason,
-                               seconds=time.perf_counter() - t0, **kw)
+        return ConvertedDesign(
+            design_id,
+            folder,
+            kw.pop("design_json", None),
+            status,
+            reason,
+            seconds=time.perf_counter() - t0,
+            **kw,
+        )
 
     try:
         with _time_limit(timeout_s):
@@ -813,8 +905,13 @@ def convert_design(batch_path: str | Path, design_id: str, fusion_volume: float 
         return result("error", f"converter failed: {type(exc).__name__}: {_short(exc)}")
 
 
-def _convert(path: Path, design_id: str, fusion_volume: float | None, fusion_area: float | None,
-             result: Callable[..., ConvertedDesign]) -> ConvertedDesign:
+def _convert(
+    path: Path,
+    design_id: str,
+    fusion_volume: float | None,
+    fusion_area: float | None,
+    result: Callable[..., ConvertedDesign],
+) -> ConvertedDesign:
     from build123d import Shape
 
     from zonegraph.data.replay import replay
@@ -855,16 +952,22 @@ def _convert(path: Path, design_id: str, fusion_volume: float | None, fusion_are
     used = {id(f.comment) for f in features if f.comment is not None}
     idle = [f"{c.sketch} -> {c.name}" for c in comments if id(c) not in used]
     if idle:  # its sketch's faces stay pending and are extruded by the next call with the next ones
-        notes.append(f"{len(comments)} feature comments, {len(idle)} without an extrude call: "
-                     + ", ".join(idle[:4]))
+        notes.append(
+            f"{len(comments)} feature comments, {len(idle)} without an extrude call: " + ", ".join(idle[:4])
+        )
     unnamed = sum(1 for f in features if f.comment is None)
     if unnamed:
         notes.append(f"{unnamed} extrude call(s) before any feature comment")
     try:
         plan = build_design(design_id, features)
     except UnsupportedFeatureError as exc:
-        return result("unsupported", exc.reason, script_fusion_volume_rel_error=script_fv,
-                      script_fusion_area_rel_error=script_fa, notes=notes)
+        return result(
+            "unsupported",
+            exc.reason,
+            script_fusion_volume_rel_error=script_fv,
+            script_fusion_area_rel_error=script_fa,
+            notes=notes,
+        )
 
     # 3. replay it and compare; a merged TwoSides that differs is retried call by call
     check = _verify(plan, part, replay)
@@ -877,9 +980,12 @@ def _convert(path: Path, design_id: str, fusion_volume: float | None, fusion_are
     if check.status == "ok" and check.reason:
         notes.append(f"verified by {check.reason}")
     common: dict[str, Any] = dict(
-        steps=len(plan.operations), operations=list(plan.operations),
-        mode_disagreements=plan.mode_disagreements, script_fusion_volume_rel_error=script_fv,
-        script_fusion_area_rel_error=script_fa, notes=notes,
+        steps=len(plan.operations),
+        operations=list(plan.operations),
+        mode_disagreements=plan.mode_disagreements,
+        script_fusion_volume_rel_error=script_fv,
+        script_fusion_area_rel_error=script_fa,
+        notes=notes,
     )
     if check.status == "replay_failed":
         invalid = " (the script's own part is an invalid solid too)" if not part.is_valid else ""
@@ -888,20 +994,29 @@ def _convert(path: Path, design_id: str, fusion_volume: float | None, fusion_are
         return result(check.status, check.reason, design_json=design_json, **common)
     fv = _rel(check.bodies_volume, fusion_volume) if fusion_volume else None
     fa = _rel(check.bodies_area, fusion_area) if fusion_area else None
-    common.update(volume_rel_error=check.volume_rel_error, area_rel_error=check.area_rel_error,
-                  fusion_volume_rel_error=fv, fusion_area_rel_error=fa)
+    common.update(
+        volume_rel_error=check.volume_rel_error,
+        area_rel_error=check.area_rel_error,
+        fusion_volume_rel_error=fv,
+        fusion_area_rel_error=fa,
+    )
     design_json = _to_json(plan, path, fusion_volume, fusion_area, check.body_count, check.face_count)
     if check.status == "mismatch":
         reason = check.reason
         if fv is not None and fa is not None and script_fv is not None and script_fa is not None:
-            reason += (f"; vs Fusion: replay {fv:.1e}/{fa:.1e}, script {script_fv:.1e}/{script_fa:.1e}"
-                       " (volume/area)")
+            reason += (
+                f"; vs Fusion: replay {fv:.1e}/{fa:.1e}, script {script_fv:.1e}/{script_fa:.1e} (volume/area)"
+            )
         return result(check.status, reason, design_json=design_json, **common)
     if fv is not None and fa is not None and script_fv is not None and script_fa is not None:
         if min(max(fv, fa), max(script_fv, script_fa)) > FUSION_RTOL:
-            return result("fusion_mismatch",
-                          f"volume/area differ from Fusion's by {fv:.3%}/{fa:.3%} (script: "
-                          f"{script_fv:.3%}/{script_fa:.3%})", design_json=design_json, **common)
+            return result(
+                "fusion_mismatch",
+                f"volume/area differ from Fusion's by {fv:.3%}/{fa:.3%} (script: "
+                f"{script_fv:.3%}/{script_fa:.3%})",
+                design_json=design_json,
+                **common,
+            )
     return result("ok", "", design_json=design_json, **common)
 
 
@@ -982,15 +1097,18 @@ def _verify(plan: _Plan, part: Any, replay: Callable[[Design], Any]) -> _Check:
     return check
 
 
-def _to_json(plan: _Plan, path: Path, volume: float | None, area: float | None, body_count: int,
-             face_count: int) -> dict:
+def _to_json(
+    plan: _Plan, path: Path, volume: float | None, area: float | None, body_count: int, face_count: int
+) -> dict:
     """Fusion-format JSON; ``properties`` carries Fusion's own volume/area and our replay's counts."""
     properties = None
     if volume is not None and area is not None:
         properties = {"volume": volume, "area": area, "body_count": body_count, "face_count": face_count}
     metadata = {
-        "parent_project": plan.design.id, "source": "fusion360_b123d",
-        "batch": f"{path.parent.name}/{path.name}", "function": f"model_{plan.design.id}",
+        "parent_project": plan.design.id,
+        "source": "fusion360_b123d",
+        "batch": f"{path.parent.name}/{path.name}",
+        "function": f"model_{plan.design.id}",
         "properties_source": "volume and area: Fusion (MODELS); body_count and face_count: zonegraph replay",
     }
     return design_to_json(plan.design, properties=properties, metadata=metadata)
@@ -1004,7 +1122,18 @@ def convert_batch(batch_path: str | Path, timeout_s: float | None = None) -> lis
 
 
 __all__ = [
-    "ConvertedDesign", "CorpusEntry", "FeatureComment", "RecordedCall", "RecordedFace", "convert_batch",
-    "convert_design", "edge_curve", "face_record", "feature_comments", "install_ocp_shims", "list_corpus",
-    "load_batch", "recording",
+    "ConvertedDesign",
+    "CorpusEntry",
+    "FeatureComment",
+    "RecordedCall",
+    "RecordedFace",
+    "convert_batch",
+    "convert_design",
+    "edge_curve",
+    "face_record",
+    "feature_comments",
+    "install_ocp_shims",
+    "list_corpus",
+    "load_batch",
+    "recording",
 ]

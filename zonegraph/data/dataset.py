@@ -85,6 +85,9 @@ def stratified_sample(groups: Sequence[str], limit: int | None, seed: int) -> li
     left = limit - sum(quota.values())
     for g in sorted(by_group, key=lambda g: -len(by_group[g]))[:left]:  # rounding remainder
         quota[g] += 1
-    chosen = [i for g, members in sorted(by_group.items())
-              for i in rng.choice(members, size=min(quota[g], len(members)), replace=False)]
+    chosen = [
+        i
+        for g, members in sorted(by_group.items())
+        for i in rng.choice(members, size=min(quota[g], len(members)), replace=False)
+    ]
     return sorted(int(i) for i in chosen)

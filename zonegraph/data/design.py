@@ -16,13 +16,12 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 
-from zonegraph.geometry.vec import Vec3
 from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError
-
+from zonegraph.geometry.vec import Vec3
 
 
 class Operation(str, enum.Enum):
@@ -151,7 +150,7 @@ class Nurbs:
         return self.weights is not None
 
 
-Curve = Union[Line, Arc, Circle, Ellipse, EllipticalArc, Nurbs]
+Curve = Line | Arc | Circle | Ellipse | EllipticalArc | Nurbs
 
 
 @dataclass(frozen=True)
@@ -237,7 +236,7 @@ class DesignProperties:
     bbox_max: Vec3 | None = None
 
 
-Entity = Union[Sketch, Extrude]
+Entity = Sketch | Extrude
 
 
 @dataclass(frozen=True)
@@ -330,15 +329,24 @@ def _parse_curve(c: dict, profile: str, design: str) -> Curve:
         return Line(_vec(c["start_point"]), _vec(c["end_point"]))
     if kind == "Arc3D":
         return Arc(
-            _vec(c["start_point"]), _vec(c["end_point"]), _vec(c["center_point"]), float(c["radius"]),
-            _vec(c["normal"]), float(c["start_angle"]), float(c["end_angle"]), _vec(c["reference_vector"]),
+            _vec(c["start_point"]),
+            _vec(c["end_point"]),
+            _vec(c["center_point"]),
+            float(c["radius"]),
+            _vec(c["normal"]),
+            float(c["start_angle"]),
+            float(c["end_angle"]),
+            _vec(c["reference_vector"]),
         )
     if kind == "Circle3D":
         return Circle(_vec(c["center_point"]), float(c["radius"]), _vec(c["normal"]))
     if kind in ("Ellipse3D", "EllipticalArc3D"):
         common = (
-            _vec(c["center_point"]), _vec(c["major_axis"]), float(c["major_axis_radius"]),
-            float(c["minor_axis_radius"]), _vec(c["normal"]),
+            _vec(c["center_point"]),
+            _vec(c["major_axis"]),
+            float(c["major_axis_radius"]),
+            float(c["minor_axis_radius"]),
+            _vec(c["normal"]),
         )
         if kind == "Ellipse3D":
             return Ellipse(*common)
@@ -346,7 +354,8 @@ def _parse_curve(c: dict, profile: str, design: str) -> Curve:
     if kind == "NurbsCurve3D":
         rational = bool(c.get("rational", False))
         return Nurbs(
-            int(c["degree"]), tuple(float(k) for k in c["knots"]),
+            int(c["degree"]),
+            tuple(float(k) for k in c["knots"]),
             tuple(_vec(p) for p in c["control_points"]),
             tuple(float(w) for w in c["weights"]) if rational else None,
             bool(c.get("periodic", False)),
@@ -386,10 +395,14 @@ def _parse_extrude(e: dict, uuid: str, design: str) -> Extrude:
     if "bodies" in e and "faces" in e:
         labels = StepLabels(len(e["bodies"]), len(e["faces"]))
     return Extrude(
-        id=uuid, name=e.get("name", ""),
+        id=uuid,
+        name=e.get("name", ""),
         profiles=tuple(ProfileRef(p["sketch"], p["profile"]) for p in e["profiles"]),
-        operation=op, extent_type=extent_type, extent_one=_parse_extent(e["extent_one"]),
-        extent_two=two, start_offset=offset,
+        operation=op,
+        extent_type=extent_type,
+        extent_one=_parse_extent(e["extent_one"]),
+        extent_two=two,
+        start_offset=offset,
         symmetric_full_length=bool(e.get("extent_one", {}).get("is_full_length", False)),
         labels=labels,
     )
@@ -400,8 +413,12 @@ def _parse_properties(p: dict | None) -> DesignProperties | None:
         return None
     bbox = p.get("bounding_box")
     return DesignProperties(
-        float(p["volume"]), float(p["area"]), int(p.get("body_count", 1)), int(p.get("face_count", 0)),
-        _vec(bbox["min_point"]) if bbox else None, _vec(bbox["max_point"]) if bbox else None,
+        float(p["volume"]),
+        float(p["area"]),
+        int(p.get("body_count", 1)),
+        int(p.get("face_count", 0)),
+        _vec(bbox["min_point"]) if bbox else None,
+        _vec(bbox["max_point"]) if bbox else None,
     )
 
 
@@ -430,39 +447,68 @@ def _pt(p: Vec3 | np.ndarray) -> dict:
 
 
 def _vc(v: Vec3 | np.ndarray) -> dict:
-    return {"type": "Vector3D", "x": float(v[0]), "y": float(v[1]), "z": float(v[2]),
-            "length": float(np.linalg.norm(v))}
+    return {
+        "type": "Vector3D",
+        "x": float(v[0]),
+        "y": float(v[1]),
+        "z": float(v[2]),
+        "length": float(np.linalg.norm(v)),
+    }
 
 
 def curve_to_json(c: Curve) -> dict:
     if isinstance(c, Line):
         return {"type": "Line3D", "start_point": _pt(c.start), "end_point": _pt(c.end)}
     if isinstance(c, Arc):
-        return {"type": "Arc3D", "start_point": _pt(c.start), "end_point": _pt(c.end),
-                "center_point": _pt(c.center), "radius": c.radius, "normal": _vc(c.normal),
-                "start_angle": c.start_angle, "end_angle": c.end_angle,
-                "reference_vector": _vc(c.reference_vector)}
+        return {
+            "type": "Arc3D",
+            "start_point": _pt(c.start),
+            "end_point": _pt(c.end),
+            "center_point": _pt(c.center),
+            "radius": c.radius,
+            "normal": _vc(c.normal),
+            "start_angle": c.start_angle,
+            "end_angle": c.end_angle,
+            "reference_vector": _vc(c.reference_vector),
+        }
     if isinstance(c, Circle):
-        return {"type": "Circle3D", "center_point": _pt(c.center), "radius": c.radius,
-                "normal": _vc(c.normal)}
+        return {
+            "type": "Circle3D",
+            "center_point": _pt(c.center),
+            "radius": c.radius,
+            "normal": _vc(c.normal),
+        }
     if isinstance(c, (Ellipse, EllipticalArc)):
-        out = {"type": "Ellipse3D", "center_point": _pt(c.center), "major_axis": _vc(c.major_axis),
-               "major_axis_radius": c.major_radius, "minor_axis_radius": c.minor_radius,
-               "normal": _vc(c.normal)}
+        out = {
+            "type": "Ellipse3D",
+            "center_point": _pt(c.center),
+            "major_axis": _vc(c.major_axis),
+            "major_axis_radius": c.major_radius,
+            "minor_axis_radius": c.minor_radius,
+            "normal": _vc(c.normal),
+        }
         if isinstance(c, EllipticalArc):
             out.update(type="EllipticalArc3D", start_angle=c.start_angle, end_angle=c.end_angle)
         return out
     if isinstance(c, Nurbs):
-        return {"type": "NurbsCurve3D", "degree": c.degree, "knots": list(c.knots),
-                "rational": c.rational, "control_points": [_pt(p) for p in c.control_points],
-                "weights": list(c.weights) if c.weights else [], "periodic": c.periodic}
+        return {
+            "type": "NurbsCurve3D",
+            "degree": c.degree,
+            "knots": list(c.knots),
+            "rational": c.rational,
+            "control_points": [_pt(p) for p in c.control_points],
+            "weights": list(c.weights) if c.weights else [],
+            "periodic": c.periodic,
+        }
     raise TypeError(f"not a curve: {c!r}")
 
 
 def _extent_json(x: Extent, is_full_length: bool | None = None) -> dict[str, Any]:
-    out: dict[str, Any] = {"type": "DistanceExtentDefinition",
-           "distance": {"type": "ModelParameter", "value": x.distance, "role": "AlongDistance"},
-           "taper_angle": {"type": "ModelParameter", "value": x.taper, "role": "TaperAngle"}}
+    out: dict[str, Any] = {
+        "type": "DistanceExtentDefinition",
+        "distance": {"type": "ModelParameter", "value": x.distance, "role": "AlongDistance"},
+        "taper_angle": {"type": "ModelParameter", "value": x.taper, "role": "TaperAngle"},
+    }
     if is_full_length is not None:
         out["is_full_length"] = is_full_length
     return out
@@ -471,13 +517,22 @@ def _extent_json(x: Extent, is_full_length: bool | None = None) -> dict[str, Any
 def sketch_to_json(s: Sketch) -> dict:
     f = s.frame
     return {
-        "name": s.name, "type": "Sketch",
-        "transform": {"origin": _pt(f.origin), "x_axis": _vc(f.x_axis), "y_axis": _vc(f.y_axis),
-                      "z_axis": _vc(f.z_axis)},
+        "name": s.name,
+        "type": "Sketch",
+        "transform": {
+            "origin": _pt(f.origin),
+            "x_axis": _vc(f.x_axis),
+            "y_axis": _vc(f.y_axis),
+            "z_axis": _vc(f.z_axis),
+        },
         "profiles": {
-            p.id: {"loops": [{"is_outer": lp.is_outer, "profile_curves": [curve_to_json(c) for c in lp.curves]}
-                             for lp in p.loops],
-                   **({"properties": {"area": p.area}} if p.area is not None else {})}
+            p.id: {
+                "loops": [
+                    {"is_outer": lp.is_outer, "profile_curves": [curve_to_json(c) for c in lp.curves]}
+                    for lp in p.loops
+                ],
+                **({"properties": {"area": p.area}} if p.area is not None else {}),
+            }
             for p in s.profiles.values()
         },
     }
@@ -485,23 +540,34 @@ def sketch_to_json(s: Sketch) -> dict:
 
 def extrude_to_json(x: Extrude) -> dict:
     out: dict[str, Any] = {
-        "name": x.name, "type": "ExtrudeFeature",
+        "name": x.name,
+        "type": "ExtrudeFeature",
         "profiles": [{"profile": r.profile, "sketch": r.sketch} for r in x.profiles],
         "operation": x.operation.value,
-        "start_extent": ({"type": "ProfilePlaneStartDefinition"} if x.start_offset == 0 else
-                         {"type": "OffsetStartDefinition",
-                          "offset": {"type": "ModelParameter", "value": x.start_offset}}),
+        "start_extent": (
+            {"type": "ProfilePlaneStartDefinition"}
+            if x.start_offset == 0
+            else {
+                "type": "OffsetStartDefinition",
+                "offset": {"type": "ModelParameter", "value": x.start_offset},
+            }
+        ),
         "extent_type": x.extent_type.value,
         "extent_one": _extent_json(
-            x.extent_one, x.symmetric_full_length if x.extent_type is ExtentType.SYMMETRIC else None),
+            x.extent_one, x.symmetric_full_length if x.extent_type is ExtentType.SYMMETRIC else None
+        ),
     }
     if x.extent_two is not None:
         out["extent_two"] = _extent_json(x.extent_two)
     return out
 
 
-def design_to_json(design: Design, extra: dict[str, dict] | None = None,
-                   properties: dict | None = None, metadata: dict | None = None) -> dict:
+def design_to_json(
+    design: Design,
+    extra: dict[str, dict] | None = None,
+    properties: dict | None = None,
+    metadata: dict | None = None,
+) -> dict:
     """Fusion-format JSON; ``extra`` adds per-entity fields (labels such as bodies/faces)."""
     entities: dict[str, dict] = {}
     for e in design.timeline:
@@ -518,7 +584,27 @@ def design_to_json(design: Design, extra: dict[str, dict] | None = None,
 
 
 __all__ = [
-    "Arc", "Circle", "Curve", "Design", "DesignProperties", "Ellipse", "EllipticalArc", "Entity",
-    "Extent", "ExtentType", "Extrude", "Frame", "Line", "Loop", "Nurbs", "Operation", "Profile",
-    "ProfileRef", "Sketch", "StepLabels", "design_to_json", "load_design", "parse_design",
+    "Arc",
+    "Circle",
+    "Curve",
+    "Design",
+    "DesignProperties",
+    "Ellipse",
+    "EllipticalArc",
+    "Entity",
+    "Extent",
+    "ExtentType",
+    "Extrude",
+    "Frame",
+    "Line",
+    "Loop",
+    "Nurbs",
+    "Operation",
+    "Profile",
+    "ProfileRef",
+    "Sketch",
+    "StepLabels",
+    "design_to_json",
+    "load_design",
+    "parse_design",
 ]

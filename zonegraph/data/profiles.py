@@ -13,14 +13,25 @@ import math
 import numpy as np
 from build123d import Edge, Face, Plane, Vector, Wire
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+from OCP.collections import Array1_double, Array1_gp_Pnt, Array1_int
 from OCP.GC import GC_MakeArcOfEllipse
 from OCP.Geom import Geom_BSplineCurve
 from OCP.gp import gp_Ax2, gp_Dir, gp_Elips, gp_Pnt
-from OCP.collections import Array1_double, Array1_gp_Pnt, Array1_int
 
-from zonegraph.data.design import Arc, Circle, Curve, Ellipse, EllipticalArc, Frame, Line, Loop, Nurbs, Profile
-from zonegraph.geometry.vec import Vec3
+from zonegraph.data.design import (
+    Arc,
+    Circle,
+    Curve,
+    Ellipse,
+    EllipticalArc,
+    Frame,
+    Line,
+    Loop,
+    Nurbs,
+    Profile,
+)
 from zonegraph.errors import DesignError, UnsupportedFeatureError
+from zonegraph.geometry.vec import Vec3
 
 SNAP_TOL = 1e-5  # cm; Fusion's float32 noise is ~1e-7, real gaps are far larger
 AREA_RTOL = 1e-4  # a built face must match Fusion's profile area this closely
@@ -93,7 +104,7 @@ def _nurbs_edge(c: Nurbs, frame: Frame, snap: _Snapper) -> Edge:
     values, mults = _unique_knots(c.knots)
     knots = Array1_double(1, len(values))
     mult = Array1_int(1, len(values))
-    for i, (k, m) in enumerate(zip(values, mults), 1):
+    for i, (k, m) in enumerate(zip(values, mults, strict=True), 1):
         knots.SetValue(i, k)
         mult.SetValue(i, m)
     if c.weights:
@@ -149,5 +160,6 @@ def profile_faces(profile: Profile, frame: Frame, where: str) -> list[Face]:
         built = sum(f.area for f in faces)
         if not math.isclose(built, profile.area, rel_tol=AREA_RTOL):
             raise DesignError(
-                where, profile.id, f"built profile area {built:.6g} differs from Fusion's {profile.area:.6g}")
+                where, profile.id, f"built profile area {built:.6g} differs from Fusion's {profile.area:.6g}"
+            )
     return list(faces)

@@ -10,16 +10,16 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 import numpy as np
 from build123d import Compound, Face, Pos, Shape, Solid, Vector
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 
 from zonegraph.data.design import Design, ExtentType, Extrude, Operation, Sketch
-from zonegraph.errors import DesignError, ReplayError, ZoneGraphError
 from zonegraph.data.profiles import profile_faces
+from zonegraph.errors import DesignError, ReplayError, ZoneGraphError
 
 TOUCH_TOL = 1e-6  # cm: a join tool this close to a body merges with it
 MIN_SPAN = 1e-9  # cm: a shorter extent is an empty extrusion
@@ -84,13 +84,24 @@ class ReplayResult:
     def summary(self) -> dict:
         """Plain-data description of the result (JSON and Parquet friendly)."""
         out = {
-            "design": self.design.id, "volume": self.volume, "area": self.area,
-            "body_count": len(self.bodies), "face_count": self.face_count, "seconds": self.seconds,
+            "design": self.design.id,
+            "volume": self.volume,
+            "area": self.area,
+            "body_count": len(self.bodies),
+            "face_count": self.face_count,
+            "seconds": self.seconds,
             "steps": [
-                {"index": i, "name": s.extrude.name, "operation": s.extrude.operation.name.lower(),
-                 "extent_type": s.extrude.extent_type.name.lower(), "tool_volume": s.tool.volume,
-                 "volume": s.volume, "body_count": s.body_count, "face_count": s.face_count,
-                 "seconds": s.seconds}
+                {
+                    "index": i,
+                    "name": s.extrude.name,
+                    "operation": s.extrude.operation.name.lower(),
+                    "extent_type": s.extrude.extent_type.name.lower(),
+                    "tool_volume": s.tool.volume,
+                    "volume": s.volume,
+                    "body_count": s.body_count,
+                    "face_count": s.face_count,
+                    "seconds": s.seconds,
+                }
                 for i, s in enumerate(self.steps)
             ],
         }
@@ -99,7 +110,8 @@ class ReplayResult:
             out["check"] = {
                 "volume_rel_error": abs(self.volume - p.volume) / max(abs(p.volume), 1e-300),
                 "area_rel_error": abs(self.area - p.area) / max(abs(p.area), 1e-300),
-                "body_count_expected": p.body_count, "face_count_expected": p.face_count,
+                "body_count_expected": p.body_count,
+                "face_count_expected": p.face_count,
             }
         return out
 

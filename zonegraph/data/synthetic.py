@@ -19,12 +19,28 @@ import numpy as np
 from build123d import Face, GeomType, Shape, Solid, Vector
 
 from zonegraph.data.design import (
-    Arc, Circle, Curve, Design, Ellipse, Extent, ExtentType, Extrude, Frame, Line, Loop, Nurbs,
-    Operation, Profile, ProfileRef, Sketch, design_to_json, parse_design,
+    Arc,
+    Circle,
+    Curve,
+    Design,
+    Ellipse,
+    Extent,
+    ExtentType,
+    Extrude,
+    Frame,
+    Line,
+    Loop,
+    Nurbs,
+    Operation,
+    Profile,
+    ProfileRef,
+    Sketch,
+    design_to_json,
+    parse_design,
 )
-from zonegraph.errors import ZoneGraphError
 from zonegraph.data.profiles import profile_faces
 from zonegraph.data.replay import ReplayStep, as_shape, replay_extrude
+from zonegraph.errors import ZoneGraphError
 
 Vec2 = tuple[float, float]
 
@@ -36,9 +52,12 @@ CONSTRUCTION_FRAMES = {
 }
 
 FUSION_SURFACE_TYPES = {
-    GeomType.PLANE: "PlaneSurfaceType", GeomType.CYLINDER: "CylinderSurfaceType",
-    GeomType.CONE: "ConeSurfaceType", GeomType.SPHERE: "SphereSurfaceType",
-    GeomType.TORUS: "TorusSurfaceType", GeomType.EXTRUSION: "ExtrusionSurfaceType",
+    GeomType.PLANE: "PlaneSurfaceType",
+    GeomType.CYLINDER: "CylinderSurfaceType",
+    GeomType.CONE: "ConeSurfaceType",
+    GeomType.SPHERE: "SphereSurfaceType",
+    GeomType.TORUS: "TorusSurfaceType",
+    GeomType.EXTRUSION: "ExtrusionSurfaceType",
 }
 
 
@@ -147,15 +166,33 @@ def _outline(kind: str, s: float, rng: np.random.Generator, angle: float, c: Vec
         return _major_segment(s / 2, u(1.15, 1.7) * math.pi, angle, c)
     if kind == "polygon":
         n = int(rng.integers(5, 9))
-        return _polyline([(s / 2 * math.cos(2 * math.pi * k / n), s / 2 * math.sin(2 * math.pi * k / n))
-                          for k in range(n)], angle, c)
+        return _polyline(
+            [
+                (s / 2 * math.cos(2 * math.pi * k / n), s / 2 * math.sin(2 * math.pi * k / n))
+                for k in range(n)
+            ],
+            angle,
+            c,
+        )
     if kind == "L":
         a, t = s / 2, s * u(0.15, 0.3)
         return _polyline([(-a, -a), (a, -a), (a, -a + t), (-a + t, -a + t), (-a + t, a), (-a, a)], angle, c)
     if kind == "T":
         a, t = s / 2, s * u(0.12, 0.2)
-        return _polyline([(-a, a), (a, a), (a, a - 2 * t), (t, a - 2 * t), (t, -a), (-t, -a),
-                          (-t, a - 2 * t), (-a, a - 2 * t)], angle, c)
+        return _polyline(
+            [
+                (-a, a),
+                (a, a),
+                (a, a - 2 * t),
+                (t, a - 2 * t),
+                (t, -a),
+                (-t, -a),
+                (-t, a - 2 * t),
+                (-a, a - 2 * t),
+            ],
+            angle,
+            c,
+        )
     if kind == "spline":
         return _spline_rect(s, s * u(0.5, 0.9), s * u(0.1, 0.25), angle, c)
     if kind == "ellipse":
@@ -174,8 +211,9 @@ def _shuffle_loop(curves: list[Curve], rng: np.random.Generator) -> tuple[Curve,
     return tuple(out[i] for i in order)
 
 
-def random_profile(rng: np.random.Generator, cfg: SyntheticConfig, size: float, centre: Vec2,
-                   pid: str, simple: bool = False) -> Profile:
+def random_profile(
+    rng: np.random.Generator, cfg: SyntheticConfig, size: float, centre: Vec2, pid: str, simple: bool = False
+) -> Profile:
     kinds = ["rect", "rounded_rect", "circle", "slot", "polygon", "L", "T", "segment"]
     weights = [0.3, 0.12, 0.2, 0.08, 0.07, 0.1, 0.05, 0.08]
     if simple:
@@ -190,7 +228,9 @@ def random_profile(rng: np.random.Generator, cfg: SyntheticConfig, size: float, 
     loops = [Loop(True, _shuffle_loop(_outline(kind, size, rng, angle, centre), rng))]
     if kind in HOLE_HOSTS and not simple and rng.random() < cfg.p_inner_loop:
         hole = "circle" if rng.random() < 0.7 else "rect"
-        loops.append(Loop(False, _shuffle_loop(_outline(hole, size * rng.uniform(0.2, 0.4), rng, angle, centre), rng)))
+        loops.append(
+            Loop(False, _shuffle_loop(_outline(hole, size * rng.uniform(0.2, 0.4), rng, angle, centre), rng))
+        )
     return Profile(pid, tuple(loops))
 
 
@@ -207,7 +247,9 @@ def _face_frame(face: Face, rng: np.random.Generator) -> tuple[Frame, float]:
     verts, tris = face.tessellate(1e-3)
     pts = np.array([tuple(v) for v in verts])
     tri = np.array(tris)
-    areas = 0.5 * np.linalg.norm(np.cross(pts[tri[:, 1]] - pts[tri[:, 0]], pts[tri[:, 2]] - pts[tri[:, 0]]), axis=1)
+    areas = 0.5 * np.linalg.norm(
+        np.cross(pts[tri[:, 1]] - pts[tri[:, 0]], pts[tri[:, 2]] - pts[tri[:, 0]]), axis=1
+    )
     k = rng.choice(len(tri), p=areas / areas.sum())
     origin = pts[tri[k]].mean(axis=0)
     normal = np.array(tuple(face.normal_at()))
@@ -259,11 +301,17 @@ class _Builder:
         """Extent fields for an extrude of roughly ``depth`` in direction ``outward`` (+1/-1)."""
         r = self.rng.random()
         if r < self.cfg.p_symmetric:
-            return dict(extent_type=ExtentType.SYMMETRIC, extent_one=Extent(depth),
-                        symmetric_full_length=bool(self.rng.random() < 0.5))
+            return dict(
+                extent_type=ExtentType.SYMMETRIC,
+                extent_one=Extent(depth),
+                symmetric_full_length=bool(self.rng.random() < 0.5),
+            )
         if r < self.cfg.p_symmetric + self.cfg.p_two_sides:
-            return dict(extent_type=ExtentType.TWO_SIDES, extent_one=Extent(outward * depth),
-                        extent_two=Extent(outward * depth * self.u(0.2, 0.8)))
+            return dict(
+                extent_type=ExtentType.TWO_SIDES,
+                extent_one=Extent(outward * depth),
+                extent_two=Extent(outward * depth * self.u(0.2, 0.8)),
+            )
         start = 0.0
         if op is not Operation.CUT and self.rng.random() < self.cfg.p_offset_start:
             start = outward * depth * self.u(0.1, 0.5)
@@ -286,7 +334,8 @@ class _Builder:
 
     def later_step(self) -> tuple[Sketch, Extrude]:
         op = [Operation.JOIN, Operation.CUT, Operation.INTERSECT][
-            int(self.rng.choice(3, p=np.array(self.cfg.op_weights) / sum(self.cfg.op_weights)))]
+            int(self.rng.choice(3, p=np.array(self.cfg.op_weights) / sum(self.cfg.op_weights)))
+        ]
         shape = as_shape(self.bodies)
         box = shape.bounding_box()
         diag = box.diagonal
@@ -317,8 +366,11 @@ class _Builder:
         local = _local(frame, centre)
         scale = 1.3 if op is Operation.INTERSECT else self.u(0.2, 0.8)
         sketch = self.sketch(frame, diag * scale, (float(local[0]), float(local[1])))
-        fields = dict(extent_type=ExtentType.SYMMETRIC, extent_one=Extent(diag * self.u(0.3, 1.2)),
-                      symmetric_full_length=True)
+        fields = dict(
+            extent_type=ExtentType.SYMMETRIC,
+            extent_one=Extent(diag * self.u(0.3, 1.2)),
+            symmetric_full_length=True,
+        )
         if self.rng.random() < 0.5:
             fields = self.extents(op, diag * self.u(0.2, 1.0), float(self.rng.choice([-1, 1])))
         return self.extrude(sketch, op, fields)
@@ -389,9 +441,12 @@ def generate_design(design_id: str, seed: int, cfg: SyntheticConfig = SyntheticC
             break
     design = Design(design_id, tuple(builder.timeline))
     labels = {s.extrude.id: step_labels(s, builder.ids) for s in builder.steps}
-    return design_to_json(design, extra=labels, properties=shape_properties(builder.steps[-1].bodies),
-                          metadata={"parent_project": design_id, "generator": "zonegraph.synthetic",
-                                    "seed": seed})
+    return design_to_json(
+        design,
+        extra=labels,
+        properties=shape_properties(builder.steps[-1].bodies),
+        metadata={"parent_project": design_id, "generator": "zonegraph.synthetic", "seed": seed},
+    )
 
 
 def step_labels(step: ReplayStep, new_id: Callable[[], str]) -> dict[str, Any]:
@@ -403,8 +458,11 @@ def step_labels(step: ReplayStep, new_id: Callable[[], str]) -> dict[str, Any]:
         for face in body.faces():
             fid = new_id()
             ids.append(fid)
-            faces[fid] = {"index": len(faces), "surface_type": FUSION_SURFACE_TYPES.get(face.geom_type, "NurbsSurfaceType"),
-                          "point_on_face": _point(face.center())}
+            faces[fid] = {
+                "index": len(faces),
+                "surface_type": FUSION_SURFACE_TYPES.get(face.geom_type, "NurbsSurfaceType"),
+                "point_on_face": _point(face.center()),
+            }
         bodies[new_id()] = {"index": b, "name": f"Body{b + 1}", "faces": ids}
     return {"bodies": bodies, "faces": faces}
 
@@ -423,9 +481,13 @@ def shape_properties(bodies: tuple[Solid, ...]) -> dict:
         counts[name] = counts.get(name, 0) + 1
     return {
         "bounding_box": {"type": "BoundingBox3D", "min_point": _point(box.min), "max_point": _point(box.max)},
-        "vertex_count": len(shape.vertices()), "edge_count": len(shape.edges()),
-        "face_count": len(shape.faces()), "shell_count": len(shape.shells()), "body_count": len(bodies),
-        "area": sum(b.area for b in bodies), "volume": sum(b.volume for b in bodies),
+        "vertex_count": len(shape.vertices()),
+        "edge_count": len(shape.edges()),
+        "face_count": len(shape.faces()),
+        "shell_count": len(shape.shells()),
+        "body_count": len(bodies),
+        "area": sum(b.area for b in bodies),
+        "volume": sum(b.volume for b in bodies),
         "center_of_mass": _point(shape.center()),
         "surface_types": [{"surface_type": k, "face_count": v} for k, v in sorted(counts.items())],
     }
