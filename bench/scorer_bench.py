@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from torch_geometric.loader import DataLoader
+from torch_geometric.data import Batch
 
 from training.data import geometry_of, state_data
 from training.model import ModelConfig, ProposalScorer
@@ -100,7 +100,7 @@ def time_state(
     canvas, props = proposals_of(graph, count)
     zones = torch.from_numpy(np.stack([p.zones for p in props]))
     ops = torch.tensor([1 if p.op is Op.UNION else -1 for p in props])
-    batch = next(iter(DataLoader([state_data(geometry, torch.from_numpy(canvas), zones, ops)])))
+    batch = Batch.from_data_list([state_data(geometry, torch.from_numpy(canvas), zones, ops)])
     heuristic = HeuristicRanker()
 
     def expansion() -> None:

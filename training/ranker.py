@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from torch_geometric.loader import DataLoader
+from torch_geometric.data import Batch
 
 from training.data import Geometry, geometry_of, state_data
 from training.model import ProposalScorer
@@ -54,7 +54,7 @@ class NetworkRanker:
         zones = torch.from_numpy(np.stack([p.zones for p in proposals]))
         ops = torch.tensor([1 if p.op is Op.UNION else -1 for p in proposals])
         data = state_data(geometry, torch.from_numpy(canvas.astype(bool)), zones, ops)
-        batch = next(iter(DataLoader([data], batch_size=1))).to(self.device)
+        batch = Batch.from_data_list([data]).to(self.device)
         with torch.no_grad():
             logits = self.model(batch, geometry=self._codes)
         return logits.softmax(dim=1)[:, 1].cpu().numpy()

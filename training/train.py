@@ -30,6 +30,7 @@ import numpy as np
 import pyarrow.dataset as ds
 import torch
 import yaml
+from torch_geometric.data import Batch
 from torch_geometric.loader import DataLoader
 
 from training.data import LabelDataset
@@ -104,7 +105,7 @@ def rank_scores(model: ProposalScorer, dataset: LabelDataset, device: torch.devi
             data = dataset[i]
             if int(data.is_gt.sum()) != 1 or len(data.is_gt) < 2:
                 continue
-            batch = next(iter(DataLoader([data], batch_size=1))).to(device)
+            batch = Batch.from_data_list([data]).to(device)
             scores = forward(model, batch).softmax(dim=1)[:, 1].cpu().numpy()
             ranks.append(relative_rank(scores, data.is_gt.numpy()))
     return ranks
