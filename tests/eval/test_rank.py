@@ -1,0 +1,76 @@
+"""Relative GT rank from label shards, on a real sample labelled rank-only."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from eval.rank import bootstrap_mean, guide_ranks, make_guides, rank_states, summarise
+from tests.conftest import gt_rows, requires_samples
+from zonegraph.data.design import load_design
+from zonegraph.data.replay import replay
+from zonegraph.jobs import label_and_save
+from zonegraph.sequence.ground_truth import ground_truth
+from zonegraph.sequence.rankers import HeuristicRanker
+from zonegraph.zones.build import build_zone_graph
+from zonegraph.zones.storage import save_zone_graph
+
+
+@pytest.fixture(scope="module")
+def labelled(samples_dir, tmp_path_factory):
+    """Couch: rank-only labels (multiplier 0: every proposal, the GT flagged) and its graph."""
+    root = tmp_path_factory.mktemp("rank")
+    r = replay(load_design(samples_dir / "Couch.json"))
+    graph = build_zone_graph(list(r.bodies), samples=0)
+    gt = ground_truth(
+        graph, [s.tool.wrapped for s in r.steps], [s["operation"] for s in r.summary()["steps"]]
+    )
+    save_zone_graph(graph, root / "graphs" / "couch")
+    label_and_save(
+        str(root / "graphs" / "couch"), gt_rows(gt.steps), "couch", "test", str(root / "labels"), multiplier=0
+    )
+    return root / "labels", root / "graphs", graph
+
+
+@requires_samples
+def test_states_rebuild_the_proposals_the_heuristic_ranks(labelled):
+    labels, graphs, graph = labelled
+    [(loaded, states)] = list(rank_states(labels, graphs, "test"))
+    assert loaded.n_zones == graph.n_zones and states
+    for state in states:
+        assert state.is_gt.sum() == 1 and len(state.proposals) == len(state.is_gt) >= 2
+        assert all(p.zones.shape == (graph.n_zones,) and p.zones.any() for p in state.proposals)
+        gt = state.proposals[int(np.flatnonzero(state.is_gt)[0])]
+        assert not np.array_equal(gt.apply(state.canvas), state.canvas)  # the GT changes the canvas
+    assert list(rank_states(labels, graphs, "train")) == []  # a split filter, not a label filter
+
+
+@requires_samples
+def test_ranks_per_guide_are_fractions_and_the_heuristic_matches_a_direct_call(labelled):
+    labels, graphs, _ = labelled
+    ranks = guide_ranks(labels, graphs, make_guides(["heuristic", "random"], seed=3), "test")
+    assert set(ranks["guide"]) == {"heuristic", "random"}
+    assert ((ranks["rank"] > 0) & (ranks["rank"] <= 1)).all()
+    assert (ranks["rank"] >= 1 / ranks["proposals"]).all()
+    [(graph, states)] = list(rank_states(labels, graphs, "test"))
+    scores = HeuristicRanker().score(graph, states[0].canvas, states[0].proposals)
+    gt = scores[states[0].is_gt][0]
+    expected = (1 + (scores > gt).sum() + 0.5 * ((scores == gt).sum() - 1)) / len(scores)
+    assert ranks[ranks.guide == "heuristic"]["rank"].iloc[0] == pytest.approx(expected)
+    again = guide_ranks(labels, graphs, make_guides(["random"], seed=3), "test")
+    assert again["rank"].tolist() == ranks[ranks.guide == "random"]["rank"].tolist()  # seeded
+
+
+def test_bootstrap_resamples_designs_and_brackets_the_mean():
+    rng = np.random.default_rng(0)
+    ranks = pd.DataFrame(
+        {"guide": "g", "design_id": np.repeat([f"d{i}" for i in range(40)], 3), "rank": rng.random(120)}
+    )
+    mean, low, high = bootstrap_mean(ranks, seed=1)
+    assert low < mean < high and mean == pytest.approx(ranks["rank"].mean())
+    assert bootstrap_mean(ranks, seed=1) == (mean, low, high)
+    one = pd.DataFrame({"guide": "g", "design_id": "d", "rank": [0.2, 0.4]})
+    assert bootstrap_mean(one) == pytest.approx((0.3, 0.3, 0.3))  # one design: no spread
+    table = summarise(ranks)
+    assert table.loc[0, "designs"] == 40 and table.loc[0, "steps"] == 120
