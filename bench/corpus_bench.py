@@ -1,15 +1,19 @@
-"""The core on real parts: zone graphs and heuristic ``infer`` on corpus designs, by timeline folder.
+"""The core on real parts: zone graphs and guided ``infer`` on corpus designs, by timeline folder.
 
     python -m bench.corpus_bench [--per-folder 25] [--budget 20] [--seed 0] [--workers 2]
+                                 [--guide heuristic|random|net] [--model PATH]
+                                 [--index data/designs/index.parquet --split test]
                                  [--corpus ../shared/data/fusion360_b123d] [--out bench_out/corpus]
 
 A seeded sample with the same number of designs from every timeline folder of the build123d corpus
 (``01_2ops`` ... ``08_21plus``). Each design is converted to our JSON (``zonegraph.data.b123d``)
-and its final shape goes through exactly what a user's ``zonegraph infer PART --guide heuristic
+and its final shape goes through exactly what a user's ``zonegraph infer PART --guide G
 --budget B`` does, in its own process under a timeout (one core each, ``--workers`` side by side):
 zone graph, search, rebuild, B-rep IoU. Prints per folder: zone graphs built, exact rate (B-rep
 IoU >= 0.9999), mean B-rep IoU, median time to exact, and every failure with its status; writes
-``results.json`` and ``results.md`` under ``--out``.
+``results.json`` and ``results.md`` under ``--out``. ``--index`` and ``--split`` keep only the designs
+of one split of a pipeline run (``data/designs/index.parquet``): a trained network is compared on
+designs it never saw.
 """
 
 from __future__ import annotations
@@ -28,10 +32,11 @@ from zonegraph.isolation import run_isolated
 from zonegraph.reconstruction import infer
 
 
-def sample(corpus: Path, per_folder: int, seed: int) -> list[CorpusEntry]:
-    """``per_folder`` designs from every timeline folder, seeded (all of a smaller folder)."""
+def sample(corpus: Path, per_folder: int, seed: int, keep: set[str] | None = None) -> list[CorpusEntry]:
+    """``per_folder`` designs from every timeline folder, seeded (all of a smaller folder), drawn
+    from the designs in ``keep`` when given."""
     rng = np.random.default_rng(seed)
-    entries = list_corpus(corpus)
+    entries = [e for e in list_corpus(corpus) if keep is None or e.design_id in keep]
     out = []
     for folder in sorted({e.folder for e in entries}):
         members = [e for e in entries if e.folder == folder]
@@ -40,19 +45,27 @@ def sample(corpus: Path, per_folder: int, seed: int) -> list[CorpusEntry]:
     return out
 
 
-def _infer(entry: CorpusEntry, budget: float, work: str) -> dict:
+def split_ids(index: Path, split: str) -> set[str]:
+    """The design ids of one split of a pipeline run's design index."""
+    import pandas as pd
+
+    table = pd.read_parquet(index, columns=["design_id", "split"])
+    return set(table.loc[table["split"] == split, "design_id"])
+
+
+def _infer(entry: CorpusEntry, config: InferConfig, work: str) -> dict:
     """Convert one design, then infer its final shape as a user would."""
     converted = convert_design(entry.batch, entry.design_id, timeout_s=120)
     if not converted.ok or converted.design_json is None:
         return {"status": f"convert_{converted.status}", "reason": converted.reason}
     path = Path(work) / f"{entry.design_id}.json"
     path.write_text(json.dumps(converted.design_json))
-    return infer(path, Path(work) / entry.design_id, InferConfig(budget_s=budget), render=False).to_dict()
+    return infer(path, Path(work) / entry.design_id, config, render=False).to_dict()
 
 
-def _job(args: tuple[CorpusEntry, float, str]) -> dict:
-    entry, budget, work = args
-    outcome = run_isolated(_infer, args, timeout=3 * budget + 240)
+def _job(args: tuple[CorpusEntry, InferConfig, str]) -> dict:
+    entry, config, work = args
+    outcome = run_isolated(_infer, args, timeout=3 * config.budget_s + 240)
     row = {"design_id": entry.design_id, "folder": entry.folder, "seconds": outcome.seconds}
     if outcome.ok:
         row.update(outcome.value)
@@ -97,12 +110,18 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", type=Path, default=Path("bench_out/corpus"))
+    parser.add_argument("--guide", default="heuristic")
+    parser.add_argument("--model", default=None, help="the net guide's checkpoint (default: shipped)")
+    parser.add_argument("--index", type=Path, default=None, help="a run's data/designs/index.parquet")
+    parser.add_argument("--split", default="test", help="the split of --index to draw from")
     args = parser.parse_args()
     require_corpus(args.corpus)
-    entries = sample(args.corpus, args.per_folder, args.seed)
-    print(f"{len(entries)} designs, heuristic, budget {args.budget:g} s, {args.workers} workers", flush=True)
+    keep = split_ids(args.index, args.split) if args.index else None
+    entries = sample(args.corpus, args.per_folder, args.seed, keep)
+    config = InferConfig(guide=args.guide, budget_s=args.budget, model=args.model)
+    print(f"{len(entries)} designs, {args.guide}, budget {args.budget:g} s, {args.workers} workers")
     with tempfile.TemporaryDirectory() as work:
-        jobs = [(e, args.budget, work) for e in entries]
+        jobs = [(e, config, work) for e in entries]
         rows = run_designs(
             _job, jobs, args.workers, lambda rs: f", {sum(bool(r.get('exact')) for r in rs)} exact"
         )

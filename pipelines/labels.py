@@ -2,10 +2,13 @@
 
 For each design of the chosen splits whose GT replays to its target on the saved zone graph, the
 labeller (``zonegraph.sequence.labels``) runs random completions from every proposal at every GT
-step. Each design is one killable Dask task that writes its own shards,
-``data/labels/proposals/<id>.parquet`` and ``data/labels/steps/<id>.parquet`` (schemas in the
-README; read the folders with ``pyarrow.dataset``), so one bad design never loses the others and
-an interrupted run resumes. ``data/metrics/labels.json`` counts designs, steps and labels.
+step. Designs of ``labels.rank_splits`` (the test split) get rank-only labels instead: every
+proposal of every captured step with the GT flagged and no completions (multiplier 0), which is
+what the relative GT rank of ``eval`` needs at a small part of the cost. Each design is one
+killable Dask task that writes its own shards, ``data/labels/proposals/<id>.parquet`` and
+``data/labels/steps/<id>.parquet`` (schemas in the README; read the folders with
+``pyarrow.dataset``), so one bad design never loses the others and an interrupted run resumes.
+``data/metrics/labels.json`` counts designs, steps and labels (rank-only designs apart).
 """
 
 from __future__ import annotations
@@ -48,13 +51,22 @@ def main() -> None:
     params = load_params()
     cfg = params["labels"]
     level, seed = int(cfg["level"]), int(cfg["seed"])
-    settings = (seed, level, float(cfg["multiplier"]), int(cfg["slack"]))
+    splits = list(cfg["splits"])
+    rank_splits = [s for s in cfg.get("rank_splits") or [] if s not in splits]
     designs = pd.read_parquet("data/gt/designs.parquet")
     steps = saved_graph_rows(pd.read_parquet("data/gt/steps.parquet"))
     column = f"captured_l{level}"
     if column not in steps:
         raise SystemExit(f"labels: level {level} is not among ground_truth.levels ({column} missing)")
-    todo = candidates(designs, list(cfg["splits"]), cfg.get("limit"), int(cfg.get("limit_seed", 0)))
+    limit, limit_seed = cfg.get("limit"), int(cfg.get("limit_seed", 0))
+    todo = pd.concat(
+        [candidates(designs, splits, limit, limit_seed), candidates(designs, rank_splits, limit, limit_seed)]
+    )
+
+    def settings(split: str) -> tuple[int, int, float, int]:
+        multiplier = 0.0 if split in rank_splits else float(cfg["multiplier"])
+        return seed, level, multiplier, int(cfg["slack"])
+
     gt_of = {
         d: [
             {
@@ -71,14 +83,16 @@ def main() -> None:
     jobs = [
         Job(
             row.design_id,
-            fingerprint(code, settings, row.split, gt_of[row.design_id], files=(GRAPHS / row.design_id,)),
+            fingerprint(
+                code, settings(row.split), row.split, gt_of[row.design_id], files=(GRAPHS / row.design_id,)
+            ),
             (
                 str(GRAPHS / row.design_id),
                 gt_of[row.design_id],
                 row.design_id,
                 row.split,
                 str(OUT),
-                *settings,
+                *settings(row.split),
             ),
             cost=float(row.graph_zones),
         )
@@ -91,13 +105,28 @@ def main() -> None:
     for shard in [*OUT.glob("proposals/*.parquet"), *OUT.glob("steps/*.parquet")]:
         if shard.stem not in keep:  # a failed design or one of an earlier, different run
             shard.unlink()
-    write_metrics(pd.DataFrame(records))
+    split_of = dict(zip(todo["design_id"], todo["split"], strict=True))
+    table = pd.DataFrame(records)
+    ranked = table["design_id"].map(split_of).isin(rank_splits) if len(table) else pd.Series(dtype=bool)
+    metrics = {**count(table[~ranked]), "rank_only": count(table[ranked])}
+    METRICS.parent.mkdir(parents=True, exist_ok=True)
+    METRICS.write_text(json.dumps(metrics, indent=2))
+    print(
+        f"labels: {metrics['labelled']}/{metrics['designs']} designs, {metrics['labelled_steps']} steps, "
+        f"{metrics['proposals']} proposals (+{metrics['positives']} / 0 {metrics['neutrals']} / "
+        f"-{metrics['negatives']}), {metrics['seconds']:.0f} s; rank-only "
+        f"{metrics['rank_only']['labelled']}/{metrics['rank_only']['designs']} designs "
+        f"({', '.join(rank_splits) or 'none'}), {metrics['rank_only']['labelled_steps']} steps"
+    )
+    for row in table[table["status"] != "ok"].itertuples():
+        print(f"  {row.design_id}: {row.status}: {row.reason}")
 
 
-def write_metrics(records: pd.DataFrame) -> None:
+def count(records: pd.DataFrame) -> dict:
+    """Designs, steps and labels of a set of job records, with the time they took."""
     ok = records[records["status"] == "ok"] if len(records) else records
     counts = ("steps", "labelled_steps", "proposals", "positives", "negatives", "neutrals", "completions")
-    metrics = {
+    return {
         "designs": int(len(records)),
         "labelled": int(len(ok)),
         "by_status": {k: int(v) for k, v in records["status"].value_counts().items()} if len(records) else {},
@@ -105,15 +134,6 @@ def write_metrics(records: pd.DataFrame) -> None:
         "seconds": float(records["seconds"].sum()) if len(records) else 0.0,
         "seconds_per_design_median": float(ok["seconds"].median()) if len(ok) else None,
     }
-    METRICS.parent.mkdir(parents=True, exist_ok=True)
-    METRICS.write_text(json.dumps(metrics, indent=2))
-    print(
-        f"labels: {metrics['labelled']}/{metrics['designs']} designs, {metrics['labelled_steps']} steps, "
-        f"{metrics['proposals']} proposals (+{metrics['positives']} / 0 {metrics['neutrals']} / "
-        f"-{metrics['negatives']}), {metrics['seconds']:.0f} s"
-    )
-    for row in records[records["status"] != "ok"].itertuples():
-        print(f"  {row.design_id}: {row.status}: {row.reason}")
 
 
 if __name__ == "__main__":

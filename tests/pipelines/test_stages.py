@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
@@ -32,7 +33,8 @@ def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):
         "zonegraph": {"simplify": True, "samples": 16, "seed": 0, "timeout_s": 120},
         "ground_truth": {"levels": [1, 3], "full_graph": True, "search_budget_s": 0.5, "timeout_s": 120},
         "labels": {
-            "splits": ["train", "test"],
+            "splits": ["train"],
+            "rank_splits": ["test"],
             "limit": None,
             "limit_seed": 0,
             "level": 1,
@@ -66,6 +68,14 @@ def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):
     per_step = proposals.groupby(["design_id", "step"])["label"]
     assert (per_step.apply(lambda x: (x == 1).sum()) == 1).all()
     assert steps["captured"].sum() == len(per_step)
+    # The test split is labelled rank-only: every proposal, the GT flagged, no completions.
+    ranked = proposals[proposals["split"] == "test"]
+    assert len(ranked) and (ranked["completions"] == 0).all() and ranked["label"].isin([0, 1]).all()
+    trained = proposals[proposals["split"] == "train"]
+    assert (trained["completions"] >= 1).any() and (trained["label"] == -1).any()
+    metrics = json.loads((tmp_path / "data/metrics/labels.json").read_text())
+    assert metrics["rank_only"]["labelled"] == ranked["design_id"].nunique()
+    assert metrics["labelled"] == trained["design_id"].nunique() and metrics["rank_only"]["completions"] == 0
     # An interrupted run resumes: the finished designs are kept, the lost one recomputed, equal.
     (tmp_path / "data/labels/records/Couch.json").unlink()
     (tmp_path / "data/labels/proposals/Couch.parquet").unlink()
