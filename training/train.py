@@ -172,16 +172,15 @@ def train(config: TrainConfig) -> dict[str, Any]:
     mlflow.set_experiment(config.experiment)
     curve, best = [], {"val_rank": float("inf")}
     with mlflow.start_run() as run:
-        mlflow.log_params(
-            {
-                **asdict(config),
-                "train_designs": len(train_ids),
-                "val_designs": len(val_ids),
-                "train_states": len(sets["train"]),
-                "device": str(device),
-            }
-        )
-        mlflow.set_tags({"data_version": data_version(config.labels_dir), "git_commit": git_commit()})
+        sizes = {
+            "train_designs": len(train_ids),
+            "val_designs": len(val_ids),
+            "train_states": len(sets["train"]),
+        }
+        mlflow.log_params({**asdict(config), **sizes, "device": str(device)})
+        tags = {"data_version": data_version(config.labels_dir), "git_commit": git_commit()}
+        mlflow.set_tags(tags)
+        provenance = {**sizes, **tags, "run_id": run.info.run_id}
         for epoch in range(1, config.epochs + 1):
             t0 = time.perf_counter()
             model.train()
@@ -211,7 +210,7 @@ def train(config: TrainConfig) -> dict[str, Any]:
             )
             if row["val_rank"] <= best["val_rank"] or not np.isfinite(best["val_rank"]):
                 best = {**row, "val_steps": len(ranks)}
-                save_checkpoint(model, config, best, out / "scorer.pt")
+                save_checkpoint(model, config, best, out / "scorer.pt", provenance)
         write_curves(curve, out)
         (out / "metrics.json").write_text(json.dumps({**best, "run_id": run.info.run_id}, indent=2))
         mlflow.log_metrics({f"best_{k}": v for k, v in best.items() if k != "epoch"})
@@ -220,13 +219,17 @@ def train(config: TrainConfig) -> dict[str, Any]:
     return best
 
 
-def save_checkpoint(model: ProposalScorer, config: TrainConfig, metrics: dict, path: Path) -> None:
+def save_checkpoint(
+    model: ProposalScorer, config: TrainConfig, metrics: dict, path: Path, provenance: dict | None = None
+) -> None:
+    """Weights with everything a model card needs: configs, best metrics, data and code versions."""
     torch.save(
         {
             "model": config.model.to_dict(),
             "state_dict": model.state_dict(),
             "train": asdict(config),
             "metrics": metrics,
+            "provenance": provenance or {},
         },
         path,
     )

@@ -15,6 +15,7 @@ import torch
 from torch_geometric.loader import DataLoader
 
 from tests.conftest import gt_rows, requires_samples
+from training.card import card
 from training.data import LabelDataset, geometry_of, state_data
 from training.loss import focal_loss
 from training.model import ModelConfig, ProposalScorer
@@ -103,6 +104,11 @@ def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_pat
     assert metrics["epoch"] == best["epoch"] and 0 < metrics["val_rank"] <= 1
     assert (tmp_path / "models" / "curve.png").stat().st_size > 1000
     assert load_scorer(tmp_path / "models" / "scorer.pt").training is False
+    checkpoint = torch.load(tmp_path / "models" / "scorer.pt", weights_only=True)
+    assert checkpoint["provenance"]["run_id"] == metrics["run_id"]
+    text = card(checkpoint, tmp_path / "models" / "scorer.pt", {"heuristic": 0.3})
+    assert f"validation relative GT rank **{metrics['val_rank']:.4f}**" in text
+    assert checkpoint["provenance"]["data_version"] in text and "heuristic 0.3000" in text
     # The run is visible through a real MLflow server's REST API.
     port = _free_port()
     server = subprocess.Popen(

@@ -1,0 +1,91 @@
+"""The model card of a checkpoint: what it was trained on, how, and how well it ranks.
+
+    python -m training.card models/scorer.pt --out training/checkpoints/MODEL_CARD.md
+        [--test-ranks eval_out/rank.json] [--note "free text"]
+
+Everything is read from the checkpoint (:func:`training.train.save_checkpoint` stores the model
+and training configuration, the best epoch's metrics and the provenance: data version, git commit,
+MLflow run, design counts), so a card cannot drift from the weights it describes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import torch
+
+DATA = (
+    "Labels of Fusion 360 Gallery reconstruction designs (Willis et al., SIGGRAPH 2021), read as "
+    "the build123d scripts of the Fusion360GalleryDataset-build123d corpus; the dataset's licence "
+    "is non-commercial research with attribution (Autodesk Fusion 360 Gallery Dataset licence), "
+    "and so is the use of these weights."
+)
+
+
+def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str = "") -> str:
+    """Markdown describing ``checkpoint`` (loaded from ``path``)."""
+    train, model, metrics = checkpoint["train"], checkpoint["model"], checkpoint["metrics"]
+    origin = checkpoint.get("provenance", {})
+    lines = [
+        f"# Model card: `{path.name}`",
+        "",
+        "The proposal scorer of the network guide (`zonegraph infer PART --guide net`): a PointNet over",
+        "zone surface samples, message passing over zone adjacency, a max pool and an MLP (paper",
+        f"sec. 4.2). Size: {path.stat().st_size / 1e6:.2f} MB, "
+        f"{sum(v.numel() for v in checkpoint['state_dict'].values()):,} parameters.",
+        "",
+        "## Data",
+        "",
+        DATA,
+        "",
+        f"- labels: `{train['labels_dir']}` (data version `{origin.get('data_version', '?')}`)",
+        f"- training designs: {origin.get('train_designs', '?')}, validation designs "
+        f"{origin.get('val_designs', '?')} (split by project, seed {train['seed']}); "
+        f"training states: {origin.get('train_states', '?')}",
+        "",
+        "## Parameters",
+        "",
+        "| parameter | value |",
+        "|---|---|",
+        *[f"| {k} | {v} |" for k, v in {**model, **train}.items() if k not in ("labels_dir", "graphs_dir")],
+        "",
+        "## Metrics",
+        "",
+        f"- best epoch {metrics['epoch']}: validation relative GT rank **{metrics['val_rank']:.4f}** "
+        f"over {metrics.get('val_steps', '?')} steps, validation focal loss {metrics['val_loss']:.4f}",
+    ]
+    if test_ranks:
+        lines.append(
+            "- test split relative GT rank: "
+            + ", ".join(f"{k} {v:.4f}" if isinstance(v, float) else f"{k} {v}" for k, v in test_ranks.items())
+        )
+    lines += [
+        "",
+        "## Provenance",
+        "",
+        f"- git commit `{origin.get('git_commit', '?')}`, MLflow run `{origin.get('run_id', '?')}`",
+        "- trained by `python -m training.train --params PARAMS` (the `train` section above) after "
+        "the `labels` stage; see the README, *The network guide*.",
+    ]
+    if note:
+        lines += ["", note]
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("checkpoint", type=Path)
+    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--test-ranks", type=Path, default=None, help="JSON of guide -> rank")
+    parser.add_argument("--note", default="")
+    args = parser.parse_args()
+    checkpoint = torch.load(args.checkpoint, map_location="cpu", weights_only=True)
+    ranks = json.loads(args.test_ranks.read_text()) if args.test_ranks else None
+    args.out.write_text(card(checkpoint, args.checkpoint, ranks, args.note))
+    print(f"model card -> {args.out}")
+
+
+if __name__ == "__main__":
+    main()
