@@ -16,7 +16,7 @@ from torch_geometric.data import Batch
 
 from training.data import Geometry, geometry_of, state_data
 from training.model import ProposalScorer
-from training.train import load_scorer
+from training.train import scorer_from
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.zones.model import ZoneGraph
 
@@ -26,7 +26,7 @@ SHIPPED = Path(__file__).resolve().parent / "checkpoints" / "scorer.pt"
 class NetworkRanker:
     """Scores proposals with a trained :class:`ProposalScorer` (P(positive), higher first)."""
 
-    samples = 128  # surface samples per zone the search should build its graphs with
+    samples = 128  # surface samples per zone the search builds graphs with: the checkpoint's own
 
     def __init__(self, model: str | Path | None = None, seed: int = 0, device: str = "cpu"):
         path = Path(model) if model else SHIPPED
@@ -34,7 +34,9 @@ class NetworkRanker:
             raise ValueError(f"{path}: no model checkpoint (train one: python -m training.train)")
         torch.manual_seed(seed)
         self.device = torch.device(device)
-        self.model: ProposalScorer = load_scorer(path, device)
+        checkpoint = torch.load(path, map_location=device, weights_only=True)
+        self.model: ProposalScorer = scorer_from(checkpoint, device)
+        self.samples = int(checkpoint["train"].get("points_per_zone") or self.samples)
         self._graph: ZoneGraph | None = None
         self._geometry: Geometry | None = None
         self._codes: torch.Tensor | None = None

@@ -237,7 +237,11 @@ def save_checkpoint(
 
 def load_scorer(path: str | Path, device: str = "cpu") -> ProposalScorer:
     """A trained scorer in eval mode."""
-    checkpoint = torch.load(path, map_location=device, weights_only=True)
+    return scorer_from(torch.load(path, map_location=device, weights_only=True), device)
+
+
+def scorer_from(checkpoint: dict, device: str = "cpu") -> ProposalScorer:
+    """The scorer a loaded checkpoint holds, in eval mode."""
     model = ProposalScorer(ModelConfig(**checkpoint["model"]))
     model.load_state_dict(checkpoint["state_dict"])
     return model.eval().to(device)
