@@ -165,3 +165,68 @@ def summarise(ranks: pd.DataFrame, level: float = 0.9, seed: int = 0) -> pd.Data
             }
         )
     return pd.DataFrame(rows)
+
+
+def markdown(table: pd.DataFrame) -> str:
+    """The summary as a Markdown table: rank with its interval per guide."""
+    lines = ["| guide | designs | steps | relative GT rank | 90% CI |", "|---|---|---|---|---|"]
+    lines += [
+        f"| {r.guide} | {r.designs} | {r.steps} | {r.rank:.4f} | {r.ci_low:.4f} - {r.ci_high:.4f} |"
+        for r in table.itertuples()
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def plot_ranks(table: pd.DataFrame, path: Path) -> Path:
+    """Bars of the mean relative rank per guide with their confidence intervals."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(1.2 * len(table) + 2, 3.2))
+    errors = [table["rank"] - table["ci_low"], table["ci_high"] - table["rank"]]
+    ax.bar(table["guide"], table["rank"], yerr=errors, capsize=4, color="C0")
+    for x, value in enumerate(table["rank"]):
+        ax.text(x, value / 2, f"{value:.3f}", ha="center", color="white")
+    ax.set(
+        ylabel="relative GT rank (lower is better)", ylim=(0, max(0.7, float(table["ci_high"].max()) + 0.05))
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def main() -> None:
+    import argparse
+    import json
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--labels", type=Path, default=Path("data/labels"))
+    parser.add_argument("--graphs", type=Path, default=Path("data/zonegraphs/graphs"))
+    parser.add_argument("--split", default="test")
+    parser.add_argument("--guides", nargs="*", default=["random", "heuristic"])
+    parser.add_argument("--model", nargs="*", default=[], help="network checkpoints to rank with")
+    parser.add_argument("--limit", type=int, default=None, help="the first N designs (by id) only")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, default=Path("eval_out/rank"))
+    args = parser.parse_args()
+    designs = None
+    if args.limit is not None:
+        steps = _read(args.labels, "steps", args.split, None)
+        designs = sorted(set(steps["design_id"]))[: args.limit]
+    ranks = guide_ranks(
+        args.labels, args.graphs, make_guides(args.guides, args.model, args.seed), args.split, designs
+    )
+    table = summarise(ranks, seed=args.seed)
+    args.out.mkdir(parents=True, exist_ok=True)
+    ranks.to_parquet(args.out / "ranks.parquet", index=False)
+    (args.out / "rank.json").write_text(json.dumps(table.to_dict(orient="records"), indent=2))
+    (args.out / "rank.md").write_text(markdown(table))
+    plot_ranks(table, args.out / "rank.png")
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.4f}"))
+
+
+if __name__ == "__main__":
+    main()
