@@ -43,6 +43,17 @@ def test_every_distinct_sample_is_exact_within_10_s(inferred):
 
 
 @requires_samples
+def test_anytime_trace_spans_both_graphs_and_ends_at_the_returned_program(inferred):
+    full_graph_wins = 0
+    for name, (_, _, result) in inferred.items():
+        times, ious = zip(*result.trace, strict=True)
+        assert list(times) == sorted(times) and list(ious) == sorted(ious), name  # only improvements
+        assert ious[-1] == result.iou_zone == 1.0 and times[-1] == result.time_to_best_s <= result.search_s
+        full_graph_wins += not result.simplified
+    assert full_graph_wins >= 1  # Hexagon: its trace continues on the full graph's clock
+
+
+@requires_samples
 def test_exported_scripts_rebuild_the_parts_in_a_fresh_process(inferred, tmp_path):
     runner = tmp_path / "run_all.py"
     runner.write_text(

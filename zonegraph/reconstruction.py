@@ -43,6 +43,12 @@ class Reconstruction:
     build_s: float  # zone-graph build seconds (both graphs)
     search_s: float  # search seconds (both graphs)
     solids: list[Solid]  # the target, in the input's units
+    trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
+
+    @property
+    def time_to_best_s(self) -> float:
+        """Search seconds until the returned program was found, over both graphs."""
+        return self.trace[-1][0] if self.trace else 0.0
 
 
 @dataclass
@@ -54,7 +60,7 @@ class InferResult:
     iou_zone: float
     iou_brep: float
     steps: int
-    time_to_best_s: float
+    time_to_best_s: float  # search seconds to the returned program (both graphs)
     build_s: float
     search_s: float
     zones: int
@@ -63,6 +69,7 @@ class InferResult:
     operations: list[str] = field(default_factory=list)  # union / subtract, in program order
     rebuild_error: str = ""
     config: dict[str, Any] = field(default_factory=dict)
+    trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -115,6 +122,7 @@ def reconstruct(
     saved = Path(saved_graph) if saved_graph else None
     best: tuple[ZoneGraph, ProposalGenerator, SearchResult] | None = None
     build_s, search_s = 0.0, 0.0
+    trace: list[tuple[float, float]] = []
     error: ZoneGraphBuildError | None = None
     for simplify in (True, False):
         try:
@@ -126,15 +134,24 @@ def reconstruct(
         left = config.budget_s - search_s
         gen = ProposalGenerator(graph, level=config.level)
         result = search(graph, ranker, _search_config(config, left * FIRST_SHARE if simplify else left), gen)
-        search_s += result.seconds
         if best is None or (result.iou, -len(result.steps)) > (best[2].iou, -len(best[2].steps)):
+            trace += _improvements(result, search_s, best[2].iou if best else -1.0)
             best = (graph, gen, result)
+        search_s += result.seconds
         if result.exact or not graph.surface_strip.any():  # no face loop: the full graph is the same
             break
     if best is None:
         assert error is not None
         raise error
-    return Reconstruction(*best, build_s=build_s, search_s=search_s, solids=solids)
+    return Reconstruction(*best, build_s=build_s, search_s=search_s, solids=solids, trace=trace)
+
+
+def _improvements(result: SearchResult, offset: float, above: float) -> list[tuple[float, float]]:
+    """A better graph's anytime trace on the clock of the whole search: the points that beat
+    ``above`` (the best IoU of the graphs searched before it), else its best alone (an equal IoU
+    in fewer steps)."""
+    points = [(offset + t, iou) for t, iou in result.trace if iou > above]
+    return points or [(offset + result.time_to_best_s, result.iou)]
 
 
 def infer(
@@ -178,7 +195,7 @@ def infer(
         iou_zone=rec.result.iou,
         iou_brep=iou,
         steps=len(program),
-        time_to_best_s=rec.result.time_to_best_s,
+        time_to_best_s=rec.time_to_best_s,
         build_s=rec.build_s,
         search_s=rec.search_s,
         zones=rec.graph.n_zones,
@@ -187,6 +204,7 @@ def infer(
         operations=[s.op.name.lower() for s in program],
         rebuild_error=rebuild_error,
         config=asdict(config),
+        trace=rec.trace,
     )
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "result.json").write_text(json.dumps(result.to_dict(), indent=2))
