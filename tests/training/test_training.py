@@ -3,11 +3,6 @@
 from __future__ import annotations
 
 import json
-import socket
-import subprocess
-import sys
-import time
-import urllib.request
 
 import numpy as np
 import pytest
@@ -15,6 +10,7 @@ import torch
 from torch_geometric.loader import DataLoader
 
 from tests.conftest import gt_rows, requires_samples
+from tests.mlflow_server import mlflow_server, search_runs
 from training.card import card
 from training.data import LabelDataset, geometry_of, state_data
 from training.loss import focal_loss
@@ -110,31 +106,8 @@ def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_pat
     assert f"validation relative GT rank **{metrics['val_rank']:.4f}**" in text
     assert checkpoint["provenance"]["data_version"] in text and "heuristic 0.3000" in text
     # The run is visible through a real MLflow server's REST API.
-    port = _free_port()
-    server = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "mlflow",
-            "server",
-            "--backend-store-uri",
-            "sqlite:///mlflow.db",
-            "--host",
-            "127.0.0.1",
-            "--port",
-            str(port),
-            "--workers",
-            "1",
-        ],
-        cwd=tmp_path,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    try:
-        runs = _search_runs(port)
-    finally:
-        server.terminate()
-        server.wait(timeout=30)
+    with mlflow_server(tmp_path) as url:
+        runs = search_runs(url, "zonegraph-scorer")
     run = next(r for r in runs if r["info"]["run_id"] == metrics["run_id"])
     names = {m["key"] for m in run["data"]["metrics"]}
     assert {"train_loss", "val_loss", "val_rank", "best_val_rank"} <= names
@@ -148,33 +121,6 @@ def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_pat
     assert scores.shape == (len(proposals),) and ((scores >= 0) & (scores <= 1)).all()
     result = search(graph, ranker, SearchConfig(budget_s=float("inf"), max_expansions=30))
     assert result.expansions > 0 and result.iou > 0
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def _search_runs(port: int) -> list[dict]:
-    url = f"http://127.0.0.1:{port}/api/2.0/mlflow"
-    deadline = time.time() + 120
-    while True:
-        try:
-            with urllib.request.urlopen(
-                f"{url}/experiments/get-by-name?experiment_name=zonegraph-scorer"
-            ) as r:
-                experiment = json.load(r)["experiment"]["experiment_id"]
-            body = json.dumps({"experiment_ids": [experiment]}).encode()
-            request = urllib.request.Request(
-                f"{url}/runs/search", data=body, headers={"Content-Type": "application/json"}
-            )
-            with urllib.request.urlopen(request) as r:
-                return json.load(r)["runs"]
-        except OSError:
-            if time.time() > deadline:
-                raise
-            time.sleep(1)
 
 
 def test_geometry_of_keeps_seeded_samples_and_both_edge_directions(samples_dir):

@@ -1,0 +1,258 @@
+"""The evaluation report: the paper's experiments on a test split (or a folder), one script.
+
+    python -m eval.report [--model PATH ...] [--designs SPLIT|FOLDER] [--budget S] [--out DIR]
+                          [--k 1 5 10] [--ablation-designs 100] [--limit N] [--workers 2]
+
+Run in a pipeline project (the ``evaluate`` DVC stage runs it on the test split), it reports:
+
+- relative GT rank of random, heuristic and each model, with 90% bootstrap intervals over
+  designs, overall and by timeline folder (from the ``labels`` stage's rank-only test labels);
+- IoU and exact rate vs search time for designs with GT length >= 3, one curve per guide at k 5,
+  zone-graph build excluded, each curve ending at the rebuilt B-rep's IoU;
+- the search-width ablation: the same curves for each ``--k`` (heuristic and network) on the
+  first ``--ablation-designs`` of them;
+- per guide, the share of inferred steps equal to a GT step and program length / GT length;
+- the ground-truth stage's coverage table and the zone statistics, when the project has them.
+
+Everything goes to ``--out`` (JSON, Markdown, CSV and PNG) and into one MLflow run of the
+``evaluation`` experiment, linked to the training run of each model. Searches are resumable.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from eval.curves import curves, plot_curves, time_grid
+from eval.programs import program_measures
+from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
+from eval.searches import Search, Target, folder_targets, run_searches, split_targets
+from zonegraph.configs import InferConfig
+
+MARKS = (1.0, 5.0, 20.0)  # seconds at which IoU and exact rate are reported as metrics
+
+
+@dataclass(frozen=True)
+class Guide:
+    name: str  # label in tables
+    guide: str  # InferConfig.guide
+    model: str | None = None
+
+
+def guides_for(models: list[str]) -> list[Guide]:
+    """Random, heuristic and one network guide per model (``net`` alone, else ``net:<file>``)."""
+    nets = [Guide("net" if len(models) == 1 else f"net:{Path(m).stem}", "net", m) for m in models]
+    return [Guide("random", "random"), Guide("heuristic", "heuristic"), *nets]
+
+
+def searches_for(
+    guides: list[Guide], targets: list[Target], ks: list[int], ablation: int, budget: float, seed: int
+) -> list[Search]:
+    """k 5 for every guide and target; the other k for heuristic and networks on the first targets."""
+    out = []
+    for g in guides:
+        for k in sorted(set(ks) | {5}):
+            if k != 5 and g.guide == "random":
+                continue
+            chosen = targets if k == 5 else targets[:ablation]
+            config = InferConfig(guide=g.guide, budget_s=budget, k=k, seed=seed, model=g.model)
+            out += [Search(g.name, config, t) for t in chosen]
+    return out
+
+
+def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tuple[pd.DataFrame, str]:
+    labels, graphs = Path(args.labels), Path(args.graphs)
+    if not (labels / "proposals").is_dir() or Path(args.designs).is_dir():
+        return pd.DataFrame(), "No rank-only labels for these designs: the rank needs the labels stage.\n"
+    rankers = make_guides(["random", "heuristic"], [g.model for g in guides if g.model], args.seed)
+    rankers = {g.name: r for g, r in zip(guides, rankers.values(), strict=True)}
+    ranks = guide_ranks(labels, graphs, rankers, args.designs, _limit(labels, args))
+    ranks.to_parquet(out / "ranks.parquet", index=False)
+    table = summarise(ranks, seed=args.seed)
+    plot_ranks(table, out / "rank.png")
+    text = "## Relative GT rank\n\n" + markdown(table) + "\n![rank](rank.png)\n"
+    folders = _folders(args)
+    if folders:
+        ranks["folder"] = ranks["design_id"].map(folders).fillna("")
+        per = ranks.groupby(["folder", "guide"], sort=True)["rank"].mean().unstack("guide")
+        text += "\nBy timeline folder (mean rank):\n\n" + _frame_md(per[table["guide"]]) + "\n"
+    return table, text
+
+
+def _limit(labels: Path, args: argparse.Namespace) -> list[str] | None:
+    if args.limit is None:
+        return None
+    steps = pd.read_parquet(labels / "steps", columns=["design_id", "split"])
+    return sorted(set(steps.loc[steps["split"] == args.designs, "design_id"]))[: args.limit]
+
+
+def _folders(args: argparse.Namespace) -> dict[str, str]:
+    index = Path(args.project) / "data/designs/index.parquet"
+    if not index.is_file():
+        return {}
+    table = pd.read_parquet(index)
+    return (
+        dict(zip(table["design_id"], table["folder"].astype(str), strict=True)) if "folder" in table else {}
+    )
+
+
+def _frame_md(frame: pd.DataFrame) -> str:
+    head = "| " + " | ".join([str(frame.index.name or ""), *map(str, frame.columns)]) + " |"
+    lines = [head, "|" + "---|" * (len(frame.columns) + 1)]
+    for idx, *values in frame.itertuples():
+        cells = [f"{v:.4f}" if isinstance(v, float) else str(v) for v in values]
+        lines.append("| " + " | ".join([str(idx), *cells]) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def search_section(
+    args: argparse.Namespace, guides: list[Guide], out: Path
+) -> tuple[pd.DataFrame, pd.DataFrame, str]:
+    targets = (
+        folder_targets(args.designs)
+        if Path(args.designs).is_dir()
+        else split_targets(args.designs, args.project)
+    )
+    targets = [t for t in targets if t.gt_length is None or t.gt_length >= args.min_gt_length][: args.limit]
+    searches = searches_for(guides, targets, args.k, args.ablation_designs, args.budget, args.seed)
+    print(f"report: {len(searches)} searches of {len(targets)} designs, budget {args.budget:g} s", flush=True)
+
+    def progress(i: int, n: int) -> None:
+        if i % 20 == 0 or i == n:
+            print(f"  {i}/{n} searches", flush=True)
+
+    results = run_searches(searches, out / "records", args.workers, args.timeout, progress)
+    grid = time_grid(args.budget)
+    table = pd.concat(
+        [curves(group, grid).assign(k=k) for k, group in results.groupby("k", sort=True)], ignore_index=True
+    )
+    table.to_csv(out / "curves.csv", index=False)
+    main = table[table["k"] == 5]
+    plot_curves(main, out / "iou_time.png", f"{len(targets)} designs, GT length >= {args.min_gt_length}, k 5")
+    text = (
+        f"## IoU vs search time ({len(targets)} designs, k 5)\n\n" + _marks_md(main) + "\n![](iou_time.png)\n"
+    )
+    ablation = table[table["guide"] != "random"].copy()
+    if ablation["k"].nunique() > 1:
+        first = {t.design_id for t in targets[: args.ablation_designs]}
+        again = curves(results[results["design_id"].isin(first)], grid).assign(k=5)
+        ablation = pd.concat([ablation[ablation["k"] != 5], again[again["guide"] != "random"]])
+        ablation["guide"] = ablation["guide"] + " k" + ablation["k"].astype(str)
+        plot_curves(ablation, out / "k_ablation.png", f"search width, {len(first)} designs")
+        text += (
+            f"\n## Search width (k), {len(first)} designs\n\n"
+            + _marks_md(ablation)
+            + "\n![](k_ablation.png)\n"
+        )
+    gt = Path(args.project) / "data/gt/steps.parquet"
+    if gt.is_file():
+        measures = program_measures(results[results["k"] == 5], pd.read_parquet(gt))
+        measures.to_csv(out / "programs.csv", index=False)
+        text += "\n## Inferred programs vs the designers'\n\n" + _frame_md(measures.set_index("guide")) + "\n"
+    return results, table, text
+
+
+def _marks(table: pd.DataFrame) -> list[float]:
+    """The report's time marks within the budget (the budget itself when it is shorter)."""
+    budget = float(table["seconds"].max())
+    return [m for m in MARKS if m <= budget + 1e-9] or [budget]
+
+
+def _marks_md(table: pd.DataFrame) -> str:
+    rows = []
+    marks = _marks(table)
+    for guide, group in table.groupby("guide", sort=False):
+        cells = []
+        for mark in marks:
+            at = group.iloc[int(np.argmin(np.abs(group["seconds"] - mark)))]
+            cells.append(f"{at.mean_iou:.3f} / {at.exact_rate:.1%}")
+        rows.append(f"| {guide} | " + " | ".join(cells) + " |")
+    head = "| guide | " + " | ".join(f"IoU / exact at {m:g} s" for m in marks) + " |"
+    return "\n".join([head, "|---|" + "---|" * len(marks), *rows]) + "\n"
+
+
+def metrics_of(rank: pd.DataFrame, curve_table: pd.DataFrame) -> dict[str, float]:
+    metrics = {}
+    for r in rank.itertuples():
+        metrics.update(
+            {
+                f"rank.{r.guide}": r.rank,
+                f"rank_ci_low.{r.guide}": r.ci_low,
+                f"rank_ci_high.{r.guide}": r.ci_high,
+            }
+        )
+    main = curve_table[curve_table["k"] == 5] if len(curve_table) else curve_table
+    for guide, group in main.groupby("guide", sort=False):
+        for mark in _marks(main):
+            at = group.iloc[int(np.argmin(np.abs(group["seconds"] - mark)))]
+            metrics[f"iou_at_{mark:g}s.{guide}"] = float(at.mean_iou)
+            metrics[f"exact_at_{mark:g}s.{guide}"] = float(at.exact_rate)
+    return {k.replace(":", "_"): v for k, v in metrics.items()}
+
+
+def extras_section(args: argparse.Namespace, out: Path) -> str:
+    """The coverage table and zone statistics the pipeline already made, copied beside the report."""
+    project, text = Path(args.project), ""
+    for source, name in (
+        (project / "data/gt/coverage.md", None),
+        (project / "data/plots/coverage.png", "coverage.png"),
+    ):
+        if source.is_file():
+            if name:
+                shutil.copy(source, out / name)
+                text += f"\n![coverage]({name})\n"
+            else:
+                text += "\n## Coverage (ground-truth stage)\n\n" + source.read_text()
+    for plot in sorted((project / "data/plots/zonegraphs").glob("*.png")):
+        shutil.copy(plot, out / f"zones_{plot.name}")
+        text += f"\n![zones](zones_{plot.name})\n"
+    return text
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--model", nargs="*", default=[], help="network checkpoints to evaluate")
+    parser.add_argument("--designs", default="test", help="a split of the project, or a folder of parts")
+    parser.add_argument("--budget", type=float, default=20.0, help="search seconds per design")
+    parser.add_argument("--out", type=Path, default=Path("eval_out"))
+    parser.add_argument("--k", type=int, nargs="*", default=[1, 5, 10])
+    parser.add_argument("--ablation-designs", type=int, default=100)
+    parser.add_argument("--min-gt-length", type=int, default=3)
+    parser.add_argument("--limit", type=int, default=None, help="the first N designs only")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--timeout", type=float, default=None, help="per search (default 3 x budget + 60)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--project", default=".", help="the pipeline project to read data/ from")
+    parser.add_argument("--labels", default="data/labels")
+    parser.add_argument("--graphs", default="data/zonegraphs/graphs")
+    parser.add_argument("--no-mlflow", action="store_true")
+    args = parser.parse_args()
+    args.timeout = args.timeout or 3 * args.budget + 60
+    for model in args.model:
+        if not Path(model).is_file():
+            raise SystemExit(f"{model}: error: no such model checkpoint")
+    args.out.mkdir(parents=True, exist_ok=True)
+    guides = guides_for(args.model)
+    rank, rank_text = rank_section(args, guides, args.out)
+    results, curve_table, search_text = search_section(args, guides, args.out)
+    report = "# Evaluation\n\n" + rank_text + "\n" + search_text + extras_section(args, args.out)
+    (args.out / "report.md").write_text(report)
+    metrics = metrics_of(rank, curve_table)
+    (args.out / "metrics.json").write_text(json.dumps(metrics, indent=2))
+    print(report.split("\n## Coverage")[0])
+    if not args.no_mlflow:
+        params = {k: v for k, v in vars(args).items() if k not in ("no_mlflow",)}
+        from eval.tracking import log_evaluation
+
+        run = log_evaluation(params, metrics, curve_table, args.out, args.model)
+        print(f"report: MLflow run {run} (experiment evaluation)")
+
+
+if __name__ == "__main__":
+    main()

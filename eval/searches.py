@@ -1,0 +1,156 @@
+"""The evaluation's searches: every (guide, k, design) ``infer``, isolated, resumable.
+
+Targets are a split of a pipeline run (the replayed final B-reps with their saved zone graphs, the
+ground-truth length from the replay) or a folder of the user's own design JSON / STEP / BREP
+files. Each search runs in a killable child under a timeout (``zonegraph.isolation``), several
+side by side, and writes one JSON record; a record made with the same settings is reused, so an
+interrupted evaluation resumes and a second run does nothing.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from zonegraph.configs import InferConfig
+from zonegraph.isolation import run_isolated
+from zonegraph.reconstruction import infer
+
+TARGET_SUFFIXES = (".json", ".step", ".stp", ".brep")
+
+
+@dataclass(frozen=True)
+class Target:
+    """One part to reconstruct: its file, the pipeline's saved zone graph if any, its GT length."""
+
+    design_id: str
+    path: str
+    graph: str | None = None
+    gt_length: int | None = None
+    folder: str = ""
+
+
+@dataclass(frozen=True)
+class Search:
+    """One search of the evaluation: a guide (with its model), a top-k, a target."""
+
+    name: str  # the guide's label in tables: random, heuristic, net, net:<model>
+    config: InferConfig
+    target: Target
+
+    @property
+    def key(self) -> str:
+        return f"{self.name.replace(':', '_')}_k{self.config.k}/{self.target.design_id}"
+
+    def fingerprint(self) -> str:
+        model = Path(self.config.model) if self.config.model else None
+        weights = model.read_bytes() if model and model.is_file() else b""
+        settings = json.dumps([asdict(self.config), asdict(self.target)], sort_keys=True, default=str)
+        return hashlib.sha1(settings.encode() + weights).hexdigest()
+
+
+def split_targets(split: str, root: str | Path = ".") -> list[Target]:
+    """The replayed designs of one split of a pipeline run (``data/replay``, ``data/designs``)."""
+    root = Path(root)
+    manifest = pd.read_parquet(root / "data/replay/manifest.parquet")
+    rows = manifest[(manifest["split"] == split) & (manifest["status"] == "ok")].sort_values("design_id")
+    index = root / "data/designs/index.parquet"
+    folders: dict[str, str] = {}
+    if index.is_file():
+        table = pd.read_parquet(index)
+        if "folder" in table:
+            folders = dict(zip(table["design_id"], table["folder"].fillna("").astype(str), strict=True))
+    return [
+        Target(
+            r.design_id,
+            str(root / r.brep_dir / "final.brep"),
+            str(root / "data/zonegraphs/graphs" / r.design_id),
+            int(r.steps),
+            folders.get(r.design_id, ""),
+        )
+        for r in rows.itertuples()
+    ]
+
+
+def folder_targets(folder: str | Path) -> list[Target]:
+    """Every design JSON, STEP or BREP file of a folder (GT length known for JSON only)."""
+    out = []
+    for path in sorted(Path(folder).iterdir()):
+        if path.suffix.lower() not in TARGET_SUFFIXES or path.name == "train_test.json":
+            continue
+        length = None
+        if path.suffix.lower() == ".json":
+            try:
+                design = json.loads(path.read_text())
+                length = sum(
+                    1 for e in design.get("entities", {}).values() if e.get("type") == "ExtrudeFeature"
+                )
+            except (OSError, json.JSONDecodeError, AttributeError):
+                length = None
+        out.append(Target(path.stem, str(path), None, length))
+    return out
+
+
+def _search(target: str, graph: str | None, config: InferConfig, out: str) -> dict:
+    result = infer(target, out, config, render=False, saved_graph=graph).to_dict()
+    result.pop("config")
+    return result
+
+
+def run_searches(
+    searches: Sequence[Search],
+    records: Path,
+    workers: int = 2,
+    timeout_s: float = 120.0,
+    progress: Callable[[int, int], None] | None = None,
+) -> pd.DataFrame:
+    """Every search (reusing records made with the same settings); one row per search."""
+
+    def one(search: Search) -> dict[str, Any]:
+        path = records / f"{search.key}.json"
+        fingerprint = search.fingerprint()
+        if path.is_file():
+            record = json.loads(path.read_text())
+            if record.get("fingerprint") == fingerprint:
+                return record
+        out = records / "programs" / search.key
+        outcome = run_isolated(
+            _search, (search.target.path, search.target.graph, search.config, str(out)), timeout_s
+        )
+        record = {
+            "guide": search.name,
+            "k": search.config.k,
+            "design_id": search.target.design_id,
+            "folder": search.target.folder,
+            "gt_length": search.target.gt_length,
+            "fingerprint": fingerprint,
+            "outcome": outcome.status,
+            "reason": outcome.reason,
+            **(outcome.value if outcome.ok and outcome.value else {}),
+        }
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(record, default=str))
+        tmp.replace(path)
+        return record
+
+    rows: list[dict[str, Any]] = []
+    with ThreadPoolExecutor(max(1, workers)) as pool:  # each search runs in its own child process
+        for i, row in enumerate(pool.map(one, searches), 1):
+            rows.append(row)
+            if progress:
+                progress(i, len(searches))
+    table = pd.DataFrame(rows)
+    for column, default in (("exact", False), ("iou_brep", 0.0), ("time_to_best_s", float("nan"))):
+        if column not in table:
+            table[column] = default
+    table["exact"] = table["exact"].fillna(False).astype(bool)
+    table["iou_brep"] = table["iou_brep"].fillna(0.0)
+    return table

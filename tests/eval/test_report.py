@@ -1,0 +1,76 @@
+"""The evaluation report on a folder of real parts, logged to a real MLflow server."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import pandas as pd
+
+from eval.searches import Search, folder_targets, run_searches
+from tests.conftest import requires_samples
+from tests.mlflow_server import mlflow_server, rest, search_runs
+from zonegraph.configs import InferConfig
+
+PARTS = ["Couch.json", "Pattern4-SteppedStartEndFace_17dd857d_0000.json"]
+
+
+@requires_samples
+def test_searches_are_isolated_recorded_and_resumed(samples_dir, tmp_path):
+    shutil.copy(samples_dir / "Couch.json", tmp_path / "Couch.json")
+    (tmp_path / "broken.step").write_text("not a STEP file")
+    targets = folder_targets(tmp_path)
+    assert [(t.design_id, t.gt_length) for t in targets] == [("Couch", 2), ("broken", None)]
+    searches = [Search("heuristic", InferConfig(budget_s=2), t) for t in targets]
+    first = run_searches(searches, tmp_path / "records", workers=2, timeout_s=120)
+    couch = first.set_index("design_id").loc["Couch"]
+    assert couch["outcome"] == "ok" and couch["exact"] and couch["trace"][-1][1] == 1.0
+    broken = first.set_index("design_id").loc["broken"]
+    assert broken["outcome"] == "invalid_input" and "corrupt" in broken["reason"] and not broken["exact"]
+    again = run_searches(searches, tmp_path / "records", workers=2, timeout_s=120)
+    assert again["time_to_best_s"].equals(first["time_to_best_s"])  # reused, not searched again
+    other = [Search("heuristic", InferConfig(budget_s=2, k=1), targets[0])]
+    assert run_searches(other, tmp_path / "records")["k"].tolist() == [1]  # other settings: a new record
+
+
+@requires_samples
+def test_report_on_a_folder_is_an_mlflow_run_with_metrics_and_plots(samples_dir, tmp_path):
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    for name in PARTS:
+        shutil.copy(samples_dir / name, parts / name)
+    with mlflow_server(tmp_path) as url:
+        rest(url, "experiments/search", {"max_results": 1})  # the server is up
+        proc = subprocess.run(
+            [sys.executable, "-m", "eval.report", "--designs", str(parts), "--budget", "2"]
+            + [
+                "--k",
+                "1",
+                "5",
+                "--ablation-designs",
+                "1",
+                "--min-gt-length",
+                "1",
+                "--out",
+                str(tmp_path / "out"),
+            ],
+            capture_output=True,
+            text=True,
+            env={**os.environ, "MLFLOW_TRACKING_URI": url},
+            timeout=600,
+        )
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        [run] = search_runs(url, "evaluation")
+        metrics = {m["key"]: m["value"] for m in run["data"]["metrics"]}
+        files = rest(url, f"artifacts/list?run_id={run['info']['run_id']}")["files"]
+    assert metrics["exact_at_1s.heuristic"] == 1.0 and 0 <= metrics["iou_at_1s.random"] <= 1
+    assert {"report.md", "iou_time.png", "k_ablation.png", "curves.csv"} <= {f["path"] for f in files}
+    curves = pd.read_csv(tmp_path / "out" / "curves.csv")
+    assert set(curves["guide"]) == {"random", "heuristic"} and set(curves["k"]) == {1, 5}
+    assert "rank needs the labels stage" in (tmp_path / "out" / "report.md").read_text()
+    written = json.loads((tmp_path / "out" / "metrics.json").read_text())
+    assert written == {k: metrics[k] for k in written}  # plus the curves, as step metrics
+    assert {"iou_curve.heuristic_k1", "exact_curve.random_k5"} <= set(metrics)
