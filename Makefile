@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 TORCH_SPEC ?= torch==2.13.0
 STAMP := $(VENV)/.installed
 
-.PHONY: install run test lint bench clean
+.PHONY: install run test lint bench ui clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +34,10 @@ bench: $(STAMP)
 	$(BIN)/python -m bench.replay_bench
 	$(BIN)/python -m bench.zonegraph_bench
 	$(BIN)/python -m bench.search_bench
+
+# The MLflow dashboard on the project's tracking store: training and evaluation runs.
+ui: $(STAMP)
+	$(BIN)/mlflow ui --backend-store-uri sqlite:///mlflow.db --port $${PORT:-5000}
 
 clean:
 	rm -rf $(VENV) data mlruns

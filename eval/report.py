@@ -2,6 +2,7 @@
 
     python -m eval.report [--model PATH ...] [--designs SPLIT|FOLDER] [--budget S] [--out DIR]
                           [--k 1 5 10] [--ablation-designs 100] [--limit N] [--workers 2]
+                          [--params params.yaml]  (its ``evaluate`` section sets the defaults)
 
 Run in a pipeline project (the ``evaluate`` DVC stage runs it on the test split), it reports:
 
@@ -232,7 +233,18 @@ def main() -> None:
     parser.add_argument("--labels", default="data/labels")
     parser.add_argument("--graphs", default="data/zonegraphs/graphs")
     parser.add_argument("--no-mlflow", action="store_true")
+    parser.add_argument("--metrics", default=None, help="also write the metrics JSON here")
+    parser.add_argument("--plot-csv", default=None, help="also write mean IoU vs time (k 5) here, wide")
+    parser.add_argument(
+        "--params", type=Path, default=None, help="defaults from this file's evaluate section"
+    )
     args = parser.parse_args()
+    if args.params is not None:
+        import yaml
+
+        section = (yaml.safe_load(args.params.read_text()) or {}).get("evaluate", {})
+        parser.set_defaults(**{k.replace("-", "_"): v for k, v in section.items()})
+        args = parser.parse_args()
     args.timeout = args.timeout or 3 * args.budget + 60
     for model in args.model:
         if not Path(model).is_file():
@@ -245,6 +257,14 @@ def main() -> None:
     (args.out / "report.md").write_text(report)
     metrics = metrics_of(rank, curve_table)
     (args.out / "metrics.json").write_text(json.dumps(metrics, indent=2))
+    if args.metrics:  # the DVC metrics file, outside the stage's output folder
+        Path(args.metrics).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(args.out / "metrics.json", args.metrics)
+    if args.plot_csv and len(curve_table):  # one column per guide, for dvc plots
+        main_curves = curve_table[curve_table["k"] == 5]
+        wide = main_curves.pivot(index="seconds", columns="guide", values="mean_iou").reset_index()
+        Path(args.plot_csv).parent.mkdir(parents=True, exist_ok=True)
+        wide.rename(columns=lambda c: str(c).replace(":", "_")).to_csv(args.plot_csv, index=False)
     print(report.split("\n## Coverage")[0])
     if not args.no_mlflow:
         params = {k: v for k, v in vars(args).items() if k not in ("no_mlflow",)}
