@@ -59,6 +59,7 @@ class TrainConfig:
     points_per_zone: int = 128
     gamma: float = 0.5
     val_fraction: float = 0.15
+    max_designs: int | None = None  # a seeded sample of the training designs (quick runs, costly fusions)
     seed: int = 0
     device: str = "auto"
     experiment: str = "zonegraph-scorer"
@@ -149,6 +150,9 @@ def train(config: TrainConfig) -> dict[str, Any]:
     np.random.seed(config.seed)
     device = pick_device(config.device)
     train_ids, val_ids = split_designs(config.labels_dir, config.seed, config.val_fraction)
+    if config.max_designs is not None and config.max_designs < len(train_ids):
+        keep = np.random.default_rng(config.seed).choice(len(train_ids), config.max_designs, replace=False)
+        train_ids = [train_ids[i] for i in sorted(keep)]
     common = dict(points_per_zone=config.points_per_zone, seed=config.seed)
     sets = {
         "train": LabelDataset(
