@@ -49,6 +49,8 @@ def test_anytime_trace_spans_both_graphs_and_ends_at_the_returned_program(inferr
         times, ious = zip(*result.trace, strict=True)
         assert list(times) == sorted(times) and list(ious) == sorted(ious), name  # only improvements
         assert ious[-1] == result.iou_zone == 1.0 and times[-1] == result.time_to_best_s <= result.search_s
+        assert len(result.step_zones) == result.steps == len(result.operations)
+        assert all(zones and max(zones) < result.zones for zones in result.step_zones)
         full_graph_wins += not result.simplified
     assert full_graph_wins >= 1  # Hexagon: its trace continues on the full graph's clock
 

@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from build123d import Solid, Unit
 
 from zonegraph.configs import InferConfig
@@ -67,6 +68,7 @@ class InferResult:
     simplified: bool
     expansions: int
     operations: list[str] = field(default_factory=list)  # union / subtract, in program order
+    step_zones: list[list[int]] = field(default_factory=list)  # each step's extrusion zones (its graph)
     rebuild_error: str = ""
     config: dict[str, Any] = field(default_factory=dict)
     trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
@@ -202,6 +204,7 @@ def infer(
         simplified=bool(rec.graph.info["simplified"]),
         expansions=rec.result.expansions,
         operations=[s.op.name.lower() for s in program],
+        step_zones=[[int(z) for z in np.flatnonzero(p.zones)] for p in rec.result.steps],
         rebuild_error=rebuild_error,
         config=asdict(config),
         trace=rec.trace,
