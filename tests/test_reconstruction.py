@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -141,3 +142,13 @@ def test_cli_infer_writes_result(samples_dir, tmp_path):
         "expansions",
     }
     assert result["config"]["guide"] == "random"
+
+
+def test_brep_iou_is_a_fraction_even_where_volume_integration_overshoots():
+    from build123d import Box, Cylinder, Pos
+
+    part = Cylinder(3.7, 2.9) - Pos(1, 0, 0) * Cylinder(0.9, 3)
+    assert 0.999999 <= brep_iou(part, part) <= 1.0
+    volume = math.pi * (3.7**2 - 0.9**2) * 2.9
+    upper = Pos(0, 0, 0.725) * Box(10, 10, 1.45)  # holds the upper half of the part
+    assert brep_iou(part, upper) == pytest.approx((volume / 2) / (145 - volume / 2 + volume), rel=1e-6)

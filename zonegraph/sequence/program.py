@@ -121,5 +121,7 @@ def brep_iou(a: Shape | None, b: Shape) -> float:
             inter = a.volume - volume_of(a.cut(b))
         except ValueError:
             raise RebuildError("Booleans against the target failed; IoU unknown") from None
-    union = a.volume + b.volume - inter
+    volume_a, volume_b = a.volume, b.volume
+    inter = min(inter, volume_a, volume_b)  # volume integration error can exceed an operand's volume
+    union = volume_a + volume_b - inter
     return inter / union if union > 0 else 1.0
