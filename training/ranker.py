@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from torch_geometric.data import Batch
 
-from training.data import Geometry, geometry_of, state_data
+from training.data import Geometry, geometry_of
 from training.model import ProposalScorer
+from training.scoring import score_state
 from training.train import scorer_from
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.zones.model import ZoneGraph
@@ -49,14 +49,11 @@ class NetworkRanker:
         return self._geometry
 
     def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
-        """(P,) P(positive) of every proposal of one state, in one batch."""
+        """(P,) P(positive) of every proposal of one state (in memory-sized chunks of proposals)."""
         if not proposals:
             return np.zeros(0)
         geometry = self._prepare(graph)
         zones = torch.from_numpy(np.stack([p.zones for p in proposals]))
         ops = torch.tensor([1 if p.op is Op.UNION else -1 for p in proposals])
-        data = state_data(geometry, torch.from_numpy(canvas.astype(bool)), zones, ops)
-        batch = Batch.from_data_list([data]).to(self.device)
-        with torch.no_grad():
-            logits = self.model(batch, geometry=self._codes)
-        return logits.softmax(dim=1)[:, 1].cpu().numpy()
+        canvas_t = torch.from_numpy(canvas.astype(bool))
+        return score_state(self.model, geometry, canvas_t, zones, ops, self.device, self._codes)

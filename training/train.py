@@ -30,12 +30,12 @@ import numpy as np
 import pyarrow.dataset as ds
 import torch
 import yaml
-from torch_geometric.data import Batch
 from torch_geometric.loader import DataLoader
 
 from training.data import LabelDataset
 from training.loss import focal_loss
 from training.model import ModelConfig, ProposalScorer
+from training.scoring import score_state
 from zonegraph.data.dataset import test_ids
 from zonegraph.sequence.rankers import relative_rank
 
@@ -99,16 +99,19 @@ def mean_loss(model: ProposalScorer, loader: DataLoader, device: torch.device, g
 
 def rank_scores(model: ProposalScorer, dataset: LabelDataset, device: torch.device) -> list[float]:
     """Relative GT rank of every state of a rank-mode dataset (states with a GT and others)."""
-    model.eval()
     ranks = []
-    with torch.no_grad():
-        for i in range(len(dataset)):
-            data = dataset[i]
-            if int(data.is_gt.sum()) != 1 or len(data.is_gt) < 2:
-                continue
-            batch = Batch.from_data_list([data]).to(device)
-            scores = forward(model, batch).softmax(dim=1)[:, 1].cpu().numpy()
-            ranks.append(relative_rank(scores, data.is_gt.numpy()))
+    for state in dataset.states:
+        if int(state.is_gt.sum()) != 1 or len(state.is_gt) < 2:
+            continue
+        scores = score_state(
+            model,
+            dataset.geometry[state.design_id],
+            torch.from_numpy(state.canvas),
+            torch.from_numpy(state.zones),
+            torch.from_numpy(state.ops),
+            device,
+        )
+        ranks.append(relative_rank(scores, state.is_gt))
     return ranks
 
 

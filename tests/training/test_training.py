@@ -128,3 +128,23 @@ def test_geometry_of_keeps_seeded_samples_and_both_edge_directions(samples_dir):
     a, b = geometry_of(graph, 16, seed=1), geometry_of(graph, 16, seed=1)
     assert a.points.shape == (graph.n_zones, 6, 16) and torch.equal(a.points, b.points)
     assert a.edge_index.shape == (2, 2 * len(graph.edges))
+
+
+@requires_samples
+@pytest.mark.parametrize("fusion", ["early", "late"])
+def test_a_state_scored_in_chunks_scores_as_in_one_pass(samples_dir, monkeypatch, fusion):
+    from training import scoring
+
+    graph = build_zone_graph(list(replay(load_design(samples_dir / "Couch.json")).bodies), samples=16)
+    canvas = np.zeros(graph.n_zones, bool)
+    proposals = ProposalGenerator(graph).proposals(canvas)
+    zones = torch.from_numpy(np.stack([p.zones for p in proposals]))
+    ops = torch.tensor([int(p.op) for p in proposals])
+    torch.manual_seed(0)
+    model = ProposalScorer(ModelConfig(fusion)).eval()
+    args = (model, geometry_of(graph, 16), torch.from_numpy(canvas), zones, ops, torch.device("cpu"))
+    whole = scoring.score_state(*args)
+    monkeypatch.setattr(scoring, "MAX_POINTS", graph.n_zones * 16 * 2)  # two proposals per pass
+    monkeypatch.setattr(scoring, "MAX_NODES", graph.n_zones * 2)
+    assert scoring.chunk_size(model, geometry_of(graph, 16)) == 2 < len(proposals)
+    assert np.allclose(scoring.score_state(*args), whole, atol=1e-6)

@@ -1,0 +1,51 @@
+"""Scoring one state's proposals, in chunks that fit in memory.
+
+In eval mode a proposal's score does not depend on the others scored with it, so a state with
+hundreds of proposals over hundreds of zones is scored in chunks of proposals: early fusion runs
+a PointNet over every sample of every zone of every proposal, and one pass over 200 proposals of
+a 500-zone graph would need about 17 GB.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+from torch import Tensor
+from torch_geometric.data import Batch
+
+from training.data import Geometry, state_data
+from training.model import ProposalScorer
+
+MAX_POINTS = 1_000_000  # zone samples per forward pass (early fusion)
+MAX_NODES = 200_000  # zone copies per forward pass (late and factored fusion)
+
+
+def chunk_size(model: ProposalScorer, geometry: Geometry) -> int:
+    """Proposals per forward pass for this model and graph."""
+    if model.config.fusion == "early":
+        return max(1, MAX_POINTS // max(1, geometry.n_zones * geometry.points.shape[2]))
+    return max(1, MAX_NODES // max(1, geometry.n_zones))
+
+
+@torch.no_grad()
+def score_state(
+    model: ProposalScorer,
+    geometry: Geometry,
+    canvas: Tensor,
+    zones: Tensor,
+    ops: Tensor,
+    device: torch.device,
+    codes: Tensor | None = None,
+) -> np.ndarray:
+    """P(positive) of each proposal of one state, in eval mode.
+
+    Shapes:
+        canvas: (Z,) bool; zones: (P, Z) bool; ops: (P,) +1 union, -1 subtract; returns (P,).
+    """
+    model.eval()
+    size, scores = chunk_size(model, geometry), []
+    for start in range(0, len(zones), size):
+        data = state_data(geometry, canvas, zones[start : start + size], ops[start : start + size])
+        logits = model(Batch.from_data_list([data]).to(device), geometry=codes)
+        scores.append(logits.softmax(dim=1)[:, 1].cpu())
+    return torch.cat(scores).numpy() if scores else np.zeros(0)
