@@ -18,9 +18,10 @@ import torch
 
 DATA = (
     "Labels of Fusion 360 Gallery reconstruction designs (Willis et al., SIGGRAPH 2021), read as "
-    "the build123d scripts of the Fusion360GalleryDataset-build123d corpus; the dataset's licence "
-    "is non-commercial research with attribution (Autodesk Fusion 360 Gallery Dataset licence), "
-    "and so is the use of these weights."
+    "the build123d scripts of the Fusion360GalleryDataset-build123d corpus, under the Fusion 360 "
+    "Gallery Dataset licence: non-commercial research use, with attribution to the Fusion 360 "
+    "Gallery Dataset (Willis et al., SIGGRAPH 2021). These weights are derived from it: use them "
+    "on the same terms."
 )
 
 

@@ -148,3 +148,23 @@ def test_a_state_scored_in_chunks_scores_as_in_one_pass(samples_dir, monkeypatch
     monkeypatch.setattr(scoring, "MAX_NODES", graph.n_zones * 2)
     assert scoring.chunk_size(model, geometry_of(graph, 16)) == 2 < len(proposals)
     assert np.allclose(scoring.score_state(*args), whole, atol=1e-6)
+
+
+@requires_samples
+def test_the_shipped_checkpoint_guides_without_a_model_path_and_has_its_card(samples_dir):
+    from training.ranker import SHIPPED
+
+    checkpoint = torch.load(SHIPPED, weights_only=True)
+    assert SHIPPED.stat().st_size < 5e6
+    card_text = (SHIPPED.parent / "MODEL_CARD.md").read_text()
+    assert (
+        f"{checkpoint['metrics']['val_rank']:.4f}" in card_text
+        and checkpoint["provenance"]["run_id"] in card_text
+    )
+    ranker = make_ranker("net")  # no --model: the shipped weights
+    assert ranker.samples == checkpoint["train"]["points_per_zone"]
+    graph = build_zone_graph(
+        list(replay(load_design(samples_dir / "Couch.json")).bodies), samples=ranker.samples
+    )
+    result = search(graph, ranker, SearchConfig(budget_s=float("inf"), max_expansions=50))
+    assert result.exact  # Couch: a box and a cut
