@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import multiprocessing
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -104,6 +105,36 @@ def _search(target: str, graph: str | None, config: InferConfig, out: str) -> di
     return result
 
 
+def _run_one(search: Search, records: Path, timeout_s: float) -> dict[str, Any]:
+    """One search's record: reused when made with the same settings, else searched and written."""
+    path = records / f"{search.key}.json"
+    fingerprint = search.fingerprint()
+    if path.is_file():
+        record = json.loads(path.read_text())
+        if record.get("fingerprint") == fingerprint:
+            return record
+    out = records / "programs" / search.key
+    outcome = run_isolated(
+        _search, (search.target.path, search.target.graph, search.config, str(out)), timeout_s
+    )
+    record = {
+        "guide": search.name,
+        "k": search.config.k,
+        "design_id": search.target.design_id,
+        "folder": search.target.folder,
+        "gt_length": search.target.gt_length,
+        "fingerprint": fingerprint,
+        "outcome": outcome.status,
+        "reason": outcome.reason,
+        **(outcome.value if outcome.ok and outcome.value else {}),
+    }
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(record, default=str))
+    tmp.replace(path)
+    return record
+
+
 def run_searches(
     searches: Sequence[Search],
     records: Path,
@@ -111,39 +142,15 @@ def run_searches(
     timeout_s: float = 120.0,
     progress: Callable[[int, int], None] | None = None,
 ) -> pd.DataFrame:
-    """Every search (reusing records made with the same settings); one row per search."""
+    """Every search (reusing records made with the same settings); one row per search.
 
-    def one(search: Search) -> dict[str, Any]:
-        path = records / f"{search.key}.json"
-        fingerprint = search.fingerprint()
-        if path.is_file():
-            record = json.loads(path.read_text())
-            if record.get("fingerprint") == fingerprint:
-                return record
-        out = records / "programs" / search.key
-        outcome = run_isolated(
-            _search, (search.target.path, search.target.graph, search.config, str(out)), timeout_s
-        )
-        record = {
-            "guide": search.name,
-            "k": search.config.k,
-            "design_id": search.target.design_id,
-            "folder": search.target.folder,
-            "gt_length": search.target.gt_length,
-            "fingerprint": fingerprint,
-            "outcome": outcome.status,
-            "reason": outcome.reason,
-            **(outcome.value if outcome.ok and outcome.value else {}),
-        }
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(record, default=str))
-        tmp.replace(path)
-        return record
-
+    Workers are spawned processes, each forking one isolated child per search: forking from a
+    thread of a multi-threaded parent can deadlock the child on a lock another thread held."""
     rows: list[dict[str, Any]] = []
-    with ThreadPoolExecutor(max(1, workers)) as pool:  # each search runs in its own child process
-        for i, row in enumerate(pool.map(one, searches), 1):
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max(1, workers), mp_context=context) as pool:
+        jobs = pool.map(_run_one, searches, [records] * len(searches), [timeout_s] * len(searches))
+        for i, row in enumerate(jobs, 1):
             rows.append(row)
             if progress:
                 progress(i, len(searches))
