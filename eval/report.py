@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from eval.curves import curves, plot_curves, time_grid
+from eval.heldout import held_out, trained_projects
 from eval.programs import program_measures
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
@@ -73,7 +74,7 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
         return pd.DataFrame(), "No rank-only labels for these designs: the rank needs the labels stage.\n"
     rankers = make_guides(["random", "heuristic"], [g.model for g in guides if g.model], args.seed)
     rankers = {g.name: r for g, r in zip(guides, rankers.values(), strict=True)}
-    ranks = guide_ranks(labels, graphs, rankers, args.designs, _limit(labels, args))
+    ranks = guide_ranks(labels, graphs, rankers, args.designs, _rank_designs(labels, args))
     ranks.to_parquet(out / "ranks.parquet", index=False)
     table = summarise(ranks, seed=args.seed)
     plot_ranks(table, out / "rank.png")
@@ -86,11 +87,11 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
     return table, text
 
 
-def _limit(labels: Path, args: argparse.Namespace) -> list[str] | None:
-    if args.limit is None:
-        return None
+def _rank_designs(labels: Path, args: argparse.Namespace) -> list[str]:
+    """The split's labelled designs, less the models' training projects, the first ``--limit``."""
     steps = pd.read_parquet(labels / "steps", columns=["design_id", "split"])
-    return sorted(set(steps.loc[steps["split"] == args.designs, "design_id"]))[: args.limit]
+    ids = held_out(sorted(set(steps.loc[steps["split"] == args.designs, "design_id"])), args.trained)
+    return ids[: args.limit]
 
 
 def _folders(args: argparse.Namespace) -> dict[str, str]:
@@ -120,7 +121,10 @@ def search_section(
         if Path(args.designs).is_dir()
         else split_targets(args.designs, args.project)
     )
-    targets = [t for t in targets if t.gt_length is None or t.gt_length >= args.min_gt_length][: args.limit]
+    kept = set(held_out([t.design_id for t in targets], args.trained))
+    targets = [
+        t for t in targets if t.design_id in kept and (t.gt_length is None or t.gt_length >= args.min_gt_length)
+    ][: args.limit]
     searches = searches_for(guides, targets, args.k, args.ablation_designs, args.budget, args.seed)
     print(f"report: {len(searches)} searches of {len(targets)} designs, budget {args.budget:g} s", flush=True)
 
@@ -137,8 +141,20 @@ def search_section(
     main = table[table["k"] == 5]
     plot_curves(main, out / "iou_time.png", f"{len(targets)} designs, GT length >= {args.min_gt_length}, k 5")
     text = (
-        f"## IoU vs search time ({len(targets)} designs, k 5)\n\n" + _marks_md(main) + "\n![](iou_time.png)\n"
+        f"## IoU vs search time ({len(targets)} designs, GT length >= {args.min_gt_length}, k 5)\n\n"
+        + _marks_md(main)
+        + "\n![](iou_time.png)\n"
     )
+    long = results[(results["k"] == 5) & (results["gt_length"].fillna(0) >= 3)]
+    if args.min_gt_length < 3 and long["design_id"].nunique():  # the paper's subset, from the same searches
+        subset = curves(long, grid)
+        subset.to_csv(out / "curves_gt3.csv", index=False)
+        plot_curves(subset, out / "iou_time_gt3.png", f"{long['design_id'].nunique()} designs, GT length >= 3, k 5")
+        text += (
+            f"\n### GT length >= 3 ({long['design_id'].nunique()} of them)\n\n"
+            + _marks_md(subset)
+            + "\n![](iou_time_gt3.png)\n"
+        )
     ablation = table[table["guide"] != "random"].copy()
     if ablation["k"].nunique() > 1:
         first = {t.design_id for t in targets[: args.ablation_designs]}
@@ -250,6 +266,11 @@ def main() -> None:
         if not Path(model).is_file():
             raise SystemExit(f"{model}: error: no such model checkpoint")
     args.out.mkdir(parents=True, exist_ok=True)
+    args.trained, silent = trained_projects(args.model)
+    for model in silent:
+        print(f"report: warning: {model} does not list its training projects; they cannot be held out")
+    if args.trained:
+        print(f"report: leaving out the designs of the {len(args.trained)} projects the models trained on")
     guides = guides_for(args.model)
     rank, rank_text = rank_section(args, guides, args.out)
     results, curve_table, search_text = search_section(args, guides, args.out)
@@ -267,7 +288,8 @@ def main() -> None:
         wide.rename(columns=lambda c: str(c).replace(":", "_")).to_csv(args.plot_csv, index=False)
     print(report.split("\n## Coverage")[0])
     if not args.no_mlflow:
-        params = {k: v for k, v in vars(args).items() if k not in ("no_mlflow",)}
+        params = {k: v for k, v in vars(args).items() if k not in ("no_mlflow", "trained")}
+        params["excluded_training_projects"] = len(args.trained)
         from eval.tracking import log_evaluation
 
         run = log_evaluation(params, metrics, curve_table, args.out, args.model)

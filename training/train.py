@@ -36,7 +36,7 @@ from training.data import LabelDataset
 from training.loss import focal_loss
 from training.model import ModelConfig, ProposalScorer
 from training.scoring import score_state
-from zonegraph.data.dataset import test_ids
+from zonegraph.data.dataset import project_of, test_ids
 from zonegraph.sequence.rankers import relative_rank
 
 DEFAULT_TRACKING = "sqlite:///mlflow.db"
@@ -187,7 +187,8 @@ def train(config: TrainConfig) -> dict[str, Any]:
         mlflow.log_params({**asdict(config), **sizes, "device": str(device)})
         tags = {"data_version": data_version(config.labels_dir), "git_commit": git_commit()}
         mlflow.set_tags(tags)
-        provenance = {**sizes, **tags, "run_id": run.info.run_id}
+        seen = sorted({project_of(d) for d in [*train_ids, *val_ids]})  # evaluation must skip these
+        provenance = {**sizes, **tags, "run_id": run.info.run_id, "train_projects": seen}
         for epoch in range(1, config.epochs + 1):
             t0 = time.perf_counter()
             model.train()
