@@ -123,7 +123,9 @@ def search_section(
     )
     kept = set(held_out([t.design_id for t in targets], args.trained))
     targets = [
-        t for t in targets if t.design_id in kept and (t.gt_length is None or t.gt_length >= args.min_gt_length)
+        t
+        for t in targets
+        if t.design_id in kept and (t.gt_length is None or t.gt_length >= args.min_gt_length)
     ][: args.limit]
     searches = searches_for(guides, targets, args.k, args.ablation_designs, args.budget, args.seed)
     print(f"report: {len(searches)} searches of {len(targets)} designs, budget {args.budget:g} s", flush=True)
@@ -149,7 +151,9 @@ def search_section(
     if args.min_gt_length < 3 and long["design_id"].nunique():  # the paper's subset, from the same searches
         subset = curves(long, grid)
         subset.to_csv(out / "curves_gt3.csv", index=False)
-        plot_curves(subset, out / "iou_time_gt3.png", f"{long['design_id'].nunique()} designs, GT length >= 3, k 5")
+        plot_curves(
+            subset, out / "iou_time_gt3.png", f"{long['design_id'].nunique()} designs, GT length >= 3, k 5"
+        )
         text += (
             f"\n### GT length >= 3 ({long['design_id'].nunique()} of them)\n\n"
             + _marks_md(subset)
