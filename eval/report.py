@@ -13,8 +13,10 @@ Run in a pipeline project (the ``evaluate`` DVC stage runs it on the test split)
 - the search-width ablation: the same curves for each ``--k`` (heuristic and network) on the
   first ``--ablation-designs`` of them;
 - per guide, the share of inferred steps equal to a GT step and program length / GT length;
+- sequence strips of a few designs every guided search solved: the GT's row, then each guide's;
 - the ground-truth stage's coverage table and the zone statistics, when the project has them.
 
+No design of a project a model trained on is scored, for any guide (``eval.heldout``).
 Everything goes to ``--out`` (JSON, Markdown, CSV and PNG) and into one MLflow run of the
 ``evaluation`` experiment, linked to the training run of each model. Searches are resumable.
 """
@@ -35,6 +37,7 @@ from eval.heldout import held_out, trained_projects
 from eval.programs import program_measures
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
+from eval.strips import pick_designs, write_strips
 from zonegraph.configs import InferConfig
 
 MARKS = (1.0, 5.0, 20.0)  # seconds at which IoU and exact rate are reported as metrics
@@ -176,7 +179,37 @@ def search_section(
         measures = program_measures(results[results["k"] == 5], pd.read_parquet(gt))
         measures.to_csv(out / "programs.csv", index=False)
         text += "\n## Inferred programs vs the designers'\n\n" + _frame_md(measures.set_index("guide")) + "\n"
+    text += strips_section(args, guides, targets, results, out)
     return results, table, text
+
+
+def strips_section(
+    args: argparse.Namespace, guides: list[Guide], targets: list[Target], results: pd.DataFrame, out: Path
+) -> str:
+    """Side-by-side strips of the GT and each guided search's sequence for a few solved designs."""
+    names = [g.name for g in guides if g.guide != "random"]
+    jsons = _design_jsons(args, targets)
+    chosen = [d for d in pick_designs(results, names, len(results)) if d in jsons]
+    paths = write_strips(chosen, jsons, out / "records", names, out, args.strips)
+    if not paths:
+        return ""
+    rows = ", ".join(["GT", *names])
+    return (
+        f"\n## Sequences (rows: {rows}; green union, red subtraction, grey the shape before)\n\n"
+        + "".join(f"![{p.stem}]({p.name})\n" for p in paths)
+    )
+
+
+def _design_jsons(args: argparse.Namespace, targets: list[Target]) -> dict[str, Path]:
+    """Each target's design JSON (its ground-truth sequence), where it has one."""
+    index = Path(args.project) / "data/designs/index.parquet"
+    jsons = {t.design_id: Path(t.path) for t in targets if t.path.lower().endswith(".json")}
+    if index.is_file():
+        table = pd.read_parquet(index, columns=["design_id", "path"])
+        jsons.update(
+            {d: Path(args.project) / p for d, p in zip(table["design_id"], table["path"], strict=True)}
+        )
+    return jsons
 
 
 def _marks(table: pd.DataFrame) -> list[float]:
@@ -245,6 +278,7 @@ def main() -> None:
     parser.add_argument("--k", type=int, nargs="*", default=[1, 5, 10])
     parser.add_argument("--ablation-designs", type=int, default=100)
     parser.add_argument("--min-gt-length", type=int, default=3)
+    parser.add_argument("--strips", type=int, default=3, help="designs drawn as sequence strips")
     parser.add_argument("--limit", type=int, default=None, help="the first N designs only")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--timeout", type=float, default=None, help="per search (default 3 x budget + 60)")

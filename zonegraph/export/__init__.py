@@ -5,7 +5,14 @@
 Imports :mod:`zonegraph.sequence`, :mod:`zonegraph.data` and :mod:`zonegraph.geometry`.
 """
 
-from zonegraph.export.render import render_sequence
+from zonegraph.export.render import StripStep, render_sequence, render_strips
 from zonegraph.export.writers import program_design, program_script, write_outputs
 
-__all__ = ["program_design", "program_script", "render_sequence", "write_outputs"]
+__all__ = [
+    "StripStep",
+    "program_design",
+    "program_script",
+    "render_sequence",
+    "render_strips",
+    "write_outputs",
+]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -48,27 +49,55 @@ def _draw(ax: Any, tris: np.ndarray, colour: Sequence[float], alpha: float) -> N
     )
 
 
-def render_sequence(program: list[ProgramStep], states: Sequence[Shape | None], path: Path) -> Path:
-    tools = [step.tool() for step in program]
-    boxes = [s.bounding_box() for s in [*tools, *[x for x in states if x is not None]]]
-    lo = np.min([tuple(b.min) for b in boxes], axis=0)
-    hi = np.max([tuple(b.max) for b in boxes], axis=0)
+@dataclass(frozen=True)
+class StripStep:
+    """One panel of a strip: the shape before the step (grey), the step's tool and whether it cuts."""
+
+    before: Shape | None
+    tool: Shape
+    subtract: bool
+    title: str
+
+
+def _bounds(rows: Sequence[Sequence[StripStep]]) -> tuple[np.ndarray, np.ndarray]:
+    shapes = [s for row in rows for step in row for s in (step.before, step.tool) if s is not None]
+    boxes = [s.bounding_box() for s in shapes]
+    return np.min([tuple(b.min) for b in boxes], axis=0), np.max([tuple(b.max) for b in boxes], axis=0)
+
+
+def render_strips(rows: dict[str, Sequence[StripStep]], path: Path) -> Path:
+    """One row of panels per named sequence, all at one scale so that rows compare side by side."""
+    rows = {name: row for name, row in rows.items() if row}
+    lo, hi = _bounds(list(rows.values()))
     tol = 2e-3 * float(np.linalg.norm(hi - lo))
-    fig = plt.figure(figsize=(3.2 * len(program) + 0.4, 3.6))
-    for i, (step, tool) in enumerate(zip(program, tools, strict=False)):
-        ax = fig.add_subplot(1, len(program), i + 1, projection="3d")
-        previous = states[i - 1] if i > 0 else None
-        if previous is not None:
-            _draw(ax, _triangles(previous, tol), COLOURS["shape"], 0.35)
-        _draw(ax, _triangles(tool, tol), COLOURS[step.op], 0.8)
-        centre, half = (lo + hi) / 2, float((hi - lo).max()) / 2
-        for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=False):
-            setter(c - half, c + half)
-        ax.set_axis_off()
-        ax.set_title(
-            f"{i + 1}: {'union' if step.op is Op.UNION else 'subtract'} {step.distance:.3g}", fontsize=9
-        )
+    centre, half = (lo + hi) / 2, float((hi - lo).max()) / 2
+    width = max(len(row) for row in rows.values())
+    fig = plt.figure(figsize=(2.8 * width + 0.6, 3.0 * len(rows)))
+    for r, (name, row) in enumerate(rows.items()):
+        for i, step in enumerate(row):
+            ax = fig.add_subplot(len(rows), width, r * width + i + 1, projection="3d")
+            if step.before is not None:
+                _draw(ax, _triangles(step.before, tol), COLOURS["shape"], 0.35)
+            _draw(ax, _triangles(step.tool, tol), COLOURS[Op.SUBTRACT if step.subtract else Op.UNION], 0.8)
+            for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=False):
+                setter(c - half, c + half)
+            ax.set_axis_off()
+            ax.set_title(f"{name} {step.title}" if i == 0 and len(rows) > 1 else step.title, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def render_sequence(program: list[ProgramStep], states: Sequence[Shape | None], path: Path) -> Path:
+    """The strip of one inferred program: panel i shows the shape after step i - 1 and step i's tool."""
+    steps = [
+        StripStep(
+            states[i - 1] if i > 0 else None,
+            step.tool(),
+            step.op is Op.SUBTRACT,
+            f"{i + 1}: {'union' if step.op is Op.UNION else 'subtract'} {step.distance:.3g}",
+        )
+        for i, step in enumerate(program)
+    ]
+    return render_strips({"": steps}, path)
