@@ -22,7 +22,7 @@ def trained_projects(models: Sequence[str | Path]) -> tuple[set[str], list[str]]
     seen: set[str] = set()
     silent = []
     for model in models:
-        provenance = torch.load(model, map_location="cpu", weights_only=False).get("provenance", {})
+        provenance = torch.load(model, map_location="cpu", weights_only=True).get("provenance", {})
         if "train_projects" in provenance:
             seen.update(provenance["train_projects"])
         else:

@@ -189,7 +189,7 @@ def strips_section(
     """Side-by-side strips of the GT and each guided search's sequence for a few solved designs."""
     names = [g.name for g in guides if g.guide != "random"]
     jsons = _design_jsons(args, targets)
-    chosen = [d for d in pick_designs(results, names, len(results)) if d in jsons]
+    chosen = [d for d in pick_designs(results, names) if d in jsons]
     paths = write_strips(chosen, jsons, out / "records", names, out, args.strips)
     if not paths:
         return ""

@@ -28,14 +28,15 @@ def design_strip(path: str | Path) -> list[StripStep]:
     return steps
 
 
-def pick_designs(results: pd.DataFrame, guides: list[str], count: int, max_steps: int = 6) -> list[str]:
-    """Designs every guide reconstructed exactly, longest GT first, short enough to draw."""
-    main = results[(results["k"] == 5) & results["guide"].isin(guides)]
+def pick_designs(results: pd.DataFrame, guides: list[str], max_steps: int = 6) -> list[str]:
+    """Designs every guide reconstructed exactly in at most ``max_steps``, longest GT first."""
+    main = results[(results["k"] == 5) & results["guide"].isin(guides)].copy()
+    main["gt_length"] = main["gt_length"].fillna(0)
     exact = main.groupby("design_id").agg(
         solved=("exact", "sum"), longest=("steps", "max"), gt=("gt_length", "first")
     )
-    exact = exact[(exact["solved"] == len(guides)) & (exact["longest"] <= max_steps) & (exact["gt"] >= 3)]
-    return list(exact.sort_values(["gt", "longest"], ascending=False, kind="stable").index[:count])
+    exact = exact[(exact["solved"] == len(guides)) & (exact["longest"] <= max_steps)]
+    return list(exact.sort_values(["gt", "longest"], ascending=False, kind="stable").index)
 
 
 def write_strips(

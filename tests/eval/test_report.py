@@ -70,7 +70,10 @@ def test_report_on_a_folder_is_an_mlflow_run_with_metrics_and_plots(samples_dir,
     assert {"report.md", "iou_time.png", "k_ablation.png", "curves.csv"} <= {f["path"] for f in files}
     curves = pd.read_csv(tmp_path / "out" / "curves.csv")
     assert set(curves["guide"]) == {"random", "heuristic"} and set(curves["k"]) == {1, 5}
-    assert "rank needs the labels stage" in (tmp_path / "out" / "report.md").read_text()
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "rank needs the labels stage" in report
+    strips = sorted(p.name for p in (tmp_path / "out").glob("strip_*.png"))
+    assert strips and all(f"({name})" in report for name in strips)  # GT and heuristic side by side
     written = json.loads((tmp_path / "out" / "metrics.json").read_text())
     assert written == {k: metrics[k] for k in written}  # plus the curves, as step metrics
     assert {"iou_curve.heuristic_k1", "exact_curve.random_k5"} <= set(metrics)

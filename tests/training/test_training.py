@@ -9,6 +9,7 @@ import pytest
 import torch
 from torch_geometric.loader import DataLoader
 
+from eval.heldout import held_out, trained_projects
 from tests.conftest import gt_rows, requires_samples
 from tests.mlflow_server import mlflow_server, search_runs
 from training.card import card
@@ -16,6 +17,7 @@ from training.data import LabelDataset, geometry_of, state_data
 from training.loss import focal_loss
 from training.model import ModelConfig, ProposalScorer
 from training.train import TrainConfig, forward, load_scorer, train
+from zonegraph.data.dataset import project_of
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.jobs import label_and_save
@@ -105,6 +107,11 @@ def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_pat
     text = card(checkpoint, tmp_path / "models" / "scorer.pt", {"heuristic": 0.3})
     assert f"validation relative GT rank **{metrics['val_rank']:.4f}**" in text
     assert checkpoint["provenance"]["data_version"] in text and "heuristic 0.3000" in text
+    # The checkpoint names the projects it trained on, and evaluation leaves their designs out.
+    seen, silent = trained_projects([tmp_path / "models" / "scorer.pt"])
+    ids = [name.split(".")[0] for name in SAMPLES]
+    assert not silent and seen == {project_of(i) for i in ids}
+    assert held_out([*ids, "unseen_project_0000"], seen) == ["unseen_project_0000"]
     # The run is visible through a real MLflow server's REST API.
     with mlflow_server(tmp_path) as url:
         runs = search_runs(url, "zonegraph-scorer")
