@@ -15,7 +15,7 @@ from zonegraph.configs import InferConfig
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import as_shape, replay
 from zonegraph.data.targets import load_target
-from zonegraph.geometry.shapes import read_solids
+from zonegraph.geometry.shapes import read_solids, write_brep
 from zonegraph.reconstruction import infer
 from zonegraph.sequence.program import brep_iou
 
@@ -152,3 +152,25 @@ def test_brep_iou_is_a_fraction_even_where_volume_integration_overshoots():
     volume = math.pi * (3.7**2 - 0.9**2) * 2.9
     upper = Pos(0, 0, 0.725) * Box(10, 10, 1.45)  # holds the upper half of the part
     assert brep_iou(part, upper) == pytest.approx((volume / 2) / (145 - volume / 2 + volume), rel=1e-6)
+    assert brep_iou(part, Pos(20, 0, 0) * Box(1, 1, 1)) == 0.0  # disjoint: an empty common is real
+
+
+def test_a_spline_profile_is_exported_so_that_our_json_replays_it(tmp_path):
+    """A free-form outline: written as a B-spline close enough that the profile's area check passes."""
+    from build123d import BuildLine, BuildPart, BuildSketch, Line, Spline, extrude, make_face
+
+    with BuildPart() as part:
+        with BuildSketch():
+            with BuildLine():
+                Spline((0, 0), (1.0, 0.7), (2.2, 0.2), (3.0, 1.1))
+                Line((3.0, 1.1), (3.0, 2.0))
+                Line((3.0, 2.0), (0, 2.0))
+                Line((0, 2.0), (0, 0))
+            make_face()
+        extrude(amount=0.8)
+    target = tmp_path / "spline.brep"
+    write_brep(part.part, target)
+    result = infer(str(target), str(tmp_path / "out"), InferConfig(budget_s=5), render=False)
+    assert result.exact
+    replayed = replay(load_design(tmp_path / "out" / "sequence.json"))
+    assert brep_iou(replayed.shape, part.part) >= 0.9999

@@ -40,6 +40,12 @@ from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.program import ProgramStep
 from zonegraph.sequence.proposals import Op
 
+# A curve that is not a line, circle or arc is written as a B-spline. build123d's default (cubic,
+# 1e-3) moved a profile's area by 1.5e-4, more than the reader's AREA_RTOL: our own JSON failed to
+# replay. A tight tolerance at a higher degree keeps the written curve on the original.
+SPLINE_DEGREE = 8
+SPLINE_TOL = 1e-7
+
 
 def step_frame(step: ProgramStep) -> Frame:
     z = np.asarray(step.direction, float)
@@ -166,7 +172,7 @@ def _curve(e: LocalEdge, edge: Edge, frame: Frame) -> Curve:
         perp = np.cross((0.0, 0.0, sign), ref)
         sweep = math.atan2(float(b @ perp), float(b @ ref)) % (2 * math.pi) or 2 * math.pi
         return Arc(p[0], p[2], vec3(centre), e.radius, (0.0, 0.0, sign), 0.0, sweep, vec3(ref))
-    spline = edge.to_splines()
+    spline = edge.to_splines(degree=SPLINE_DEGREE, tolerance=SPLINE_TOL)
     geom = spline.geom_adaptor().BSpline()
     poles = [_local(frame, (q.X(), q.Y(), q.Z())) for q in geom.Poles()]
     knots = [k for k, m in zip(geom.Knots(), geom.Multiplicities(), strict=False) for _ in range(m)]

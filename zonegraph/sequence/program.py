@@ -111,16 +111,23 @@ def execute(program: list[ProgramStep]) -> list[Shape | None]:
 
 
 def brep_iou(a: Shape | None, b: Shape) -> float:
-    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans (the common part, else a - b)."""
+    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans (the common part, else a - b).
+
+    A common of two nearly coincident solids with B-spline faces can come back empty on the first
+    call (the Boolean then fixes tolerances in place and a second call succeeds): an empty common
+    is therefore measured again through the difference, and only when both fail is IoU unknown."""
     if a is None:
         return 0.0
     try:
         inter = volume_of(a.intersect(b))
     except ValueError:  # a null Boolean result: measure the same thing through the difference
+        inter = 0.0
+    if inter <= 0.0:
         try:
-            inter = a.volume - volume_of(a.cut(b))
+            rest = a.cut(b)
         except ValueError:
             raise RebuildError("Booleans against the target failed; IoU unknown") from None
+        inter = a.volume - volume_of(rest)
     volume_a, volume_b = a.volume, b.volume
     inter = min(inter, volume_a, volume_b)  # volume integration error can exceed an operand's volume
     union = volume_a + volume_b - inter
