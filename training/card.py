@@ -45,6 +45,8 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
         f"- training designs: {origin.get('train_designs', '?')}, validation designs "
         f"{origin.get('val_designs', '?')} (split by project, seed {train['seed']}); "
         f"training states: {origin.get('train_states', '?')}",
+        f"- training projects: {len(origin.get('train_projects', [])) or '?'}, listed in the checkpoint "
+        "(`provenance.train_projects`): `eval.report` leaves every design of them out",
         "",
         "## Parameters",
         "",
