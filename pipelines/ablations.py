@@ -84,7 +84,8 @@ def main() -> None:
     table = summarise(ranks, seed=base.seed)
     plot_ranks(table, args.out / "ablations.png")
     text = (
-        f"## Ablations: relative GT rank on {len(designs)} held-out test designs\n\n"
+        f"## Ablations: relative GT rank on {ranks['design_id'].nunique()} held-out test designs\n\n"
+        f"(the first {len(designs)} by id; the others have no step with a captured GT and another proposal)\n"
         f"Each network trained on {args.designs} designs for {args.epochs} epochs "
         f"({base.fusion} fusion, {base.points_per_zone} points per zone).\n\n" + markdown(table)
     )

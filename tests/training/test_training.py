@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ import torch
 from torch_geometric.loader import DataLoader
 
 from eval.heldout import held_out, trained_projects
+from pipelines.ablations import train_variant, variants
 from tests.conftest import gt_rows, requires_samples
 from tests.mlflow_server import mlflow_server, search_runs
 from training.card import card
@@ -175,3 +177,26 @@ def test_the_shipped_checkpoint_guides_without_a_model_path_and_has_its_card(sam
     )
     result = search(graph, ranker, SearchConfig(budget_s=float("inf"), max_expansions=50))
     assert result.exact  # Couch: a box and a cut
+
+
+@requires_samples
+def test_an_ablation_variant_trains_once_then_is_reused(labelled, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    base = TrainConfig(
+        labels_dir=str(labelled / "labels"),
+        graphs_dir=str(labelled / "graphs"),
+        epochs=1,
+        val_fraction=0.34,
+        points_per_zone=16,
+        batch_states=4,
+        device="cpu",
+        experiment="ablations",
+    )
+    configs = variants(base, [0])
+    assert list(configs) == ["rounds0", "rounds3_no_points"] and not configs["rounds3_no_points"].use_points
+    path = train_variant("rounds0", configs["rounds0"], tmp_path / "out")
+    assert torch.load(path, weights_only=True)["model"]["rounds"] == 0
+    written = path.stat().st_mtime_ns
+    assert train_variant("rounds0", configs["rounds0"], tmp_path / "out").stat().st_mtime_ns == written
+    other = train_variant("rounds0", replace(configs["rounds0"], lr=1e-3), tmp_path / "out")
+    assert other.stat().st_mtime_ns != written  # another config: trained again
