@@ -210,6 +210,9 @@ def train(config: TrainConfig) -> dict[str, Any]:
                 "val_rank": float(np.mean(ranks)) if ranks else float("nan"),
                 "seconds": time.perf_counter() - t0,
             }
+            if not np.isfinite(row["train_loss"]):
+                print(f"epoch {epoch}: the training loss is not finite; stopping", flush=True)
+                break
             curve.append(row)
             mlflow.log_metrics({k: v for k, v in row.items() if k != "epoch"}, step=epoch)
             print(
@@ -219,6 +222,8 @@ def train(config: TrainConfig) -> dict[str, Any]:
             if row["val_rank"] <= best["val_rank"] or not np.isfinite(best["val_rank"]):
                 best = {**row, "val_steps": len(ranks)}
                 save_checkpoint(model, config, best, out / "scorer.pt", provenance)
+        if not curve:
+            raise SystemExit("train: no epoch finished with a finite loss; no checkpoint written")
         write_curves(curve, out)
         (out / "metrics.json").write_text(json.dumps({**best, "run_id": run.info.run_id}, indent=2))
         mlflow.log_metrics({f"best_{k}": v for k, v in best.items() if k != "epoch"})

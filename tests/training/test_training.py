@@ -26,7 +26,7 @@ from zonegraph.jobs import label_and_save
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.proposals import ProposalGenerator
-from zonegraph.sequence.rankers import make_ranker
+from zonegraph.sequence.rankers import make_ranker, relative_rank
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.storage import save_zone_graph
 
@@ -43,6 +43,14 @@ def test_focal_loss_is_cross_entropy_at_gamma_zero_and_discounts_easy_examples()
     ce = torch.nn.functional.cross_entropy(logits, target)
     assert torch.isclose(focal_loss(logits, target, 0.0), ce)
     assert focal_loss(logits, target, 2.0) < focal_loss(logits, target, 0.5) < ce
+    sure = torch.tensor([[40.0, -40.0], [0.0, 1.0]], requires_grad=True)  # p of the first rounds to 1
+    focal_loss(sure, torch.tensor([0, 1]), 0.5).backward()
+    assert torch.isfinite(sure.grad).all()  # the slope of (1 - p)^0.5 at p = 1 made it NaN
+
+
+def test_a_nan_score_ranks_last():
+    assert relative_rank(np.array([np.nan, 0.2, 0.1]), np.array([True, False, False])) == 1.0
+    assert relative_rank(np.array([0.5, np.nan, np.nan]), np.array([True, False, False])) == 1 / 3
 
 
 @pytest.fixture(scope="module")

@@ -106,6 +106,7 @@ def relative_rank(scores: np.ndarray, is_gt: np.ndarray) -> float:
     Shapes:
         scores: (P,) float, higher first; is_gt: (P,) bool with exactly one true.
     """
+    scores = np.where(np.isnan(scores), -np.inf, scores)  # a NaN score ranks last, never first
     gt = float(scores[np.flatnonzero(is_gt)[0]])
     others = np.delete(scores, np.flatnonzero(is_gt)[0])
     rank = 1 + float((others > gt).sum()) + 0.5 * float((others == gt).sum())
