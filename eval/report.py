@@ -165,7 +165,8 @@ def search_section(
     ablation = table[table["guide"] != "random"].copy()
     if ablation["k"].nunique() > 1:
         first = {t.design_id for t in targets[: args.ablation_designs]}
-        again = curves(results[results["design_id"].isin(first)], grid).assign(k=5)
+        chosen = results[(results["k"] == 5) & results["design_id"].isin(first)]
+        again = curves(chosen, grid).assign(k=5)
         ablation = pd.concat([ablation[ablation["k"] != 5], again[again["guide"] != "random"]])
         ablation["guide"] = ablation["guide"] + " k" + ablation["k"].astype(str)
         plot_curves(ablation, out / "k_ablation.png", f"search width, {len(first)} designs")
