@@ -51,9 +51,11 @@ class Search:
         return f"{self.name.replace(':', '_')}_k{self.config.k}/{self.target.design_id}"
 
     def fingerprint(self) -> str:
+        """The settings and the model's bytes; not the model's path, so a moved project resumes."""
         model = Path(self.config.model) if self.config.model else None
         weights = model.read_bytes() if model and model.is_file() else b""
-        settings = json.dumps([asdict(self.config), asdict(self.target)], sort_keys=True, default=str)
+        config = {**asdict(self.config), "model": bool(model)}
+        settings = json.dumps([config, asdict(self.target)], sort_keys=True, default=str)
         return hashlib.sha1(settings.encode() + weights).hexdigest()
 
 

@@ -13,6 +13,7 @@ import pandas as pd
 from eval.searches import Search, folder_targets, run_searches
 from tests.conftest import requires_samples
 from tests.mlflow_server import mlflow_server, rest, search_runs
+from training.ranker import SHIPPED
 from zonegraph.configs import InferConfig
 
 PARTS = ["Couch.json", "Pattern4-SteppedStartEndFace_17dd857d_0000.json"]
@@ -34,6 +35,13 @@ def test_searches_are_isolated_recorded_and_resumed(samples_dir, tmp_path):
     assert again["time_to_best_s"].equals(first["time_to_best_s"])  # reused, not searched again
     other = [Search("heuristic", InferConfig(budget_s=2, k=1), targets[0])]
     assert run_searches(other, tmp_path / "records")["k"].tolist() == [1]  # other settings: a new record
+    for name in ("a.pt", "b.pt"):  # the same weights at two paths: one record
+        shutil.copy(SHIPPED, tmp_path / name)
+    net = [
+        Search("net", InferConfig(guide="net", budget_s=2, model=str(tmp_path / f"{n}.pt")), targets[0])
+        for n in "ab"
+    ]
+    assert net[0].fingerprint() == net[1].fingerprint() != searches[0].fingerprint()
 
 
 @requires_samples
