@@ -174,3 +174,16 @@ def test_a_spline_profile_is_exported_so_that_our_json_replays_it(tmp_path):
     assert result.exact
     replayed = replay(load_design(tmp_path / "out" / "sequence.json"))
     assert brep_iou(replayed.shape, part.part) >= 0.9999
+
+
+@requires_samples
+def test_a_graph_without_face_loops_gets_the_whole_budget(samples_dir):
+    from zonegraph.reconstruction import FIRST_SHARE, budget_share
+    from zonegraph.zones.build import build_zone_graph
+
+    def graph(name: str, simplify: bool = True):
+        return build_zone_graph(list(replay(load_design(samples_dir / name)).bodies), simplify=simplify)
+
+    assert budget_share(graph("Couch.json"), simplified=True) == 1.0  # no face loop
+    assert budget_share(graph("Hexagon.json"), simplified=True) == FIRST_SHARE  # the full graph may follow
+    assert budget_share(graph("Hexagon.json", simplify=False), simplified=False) == 1.0

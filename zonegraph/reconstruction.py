@@ -102,6 +102,13 @@ def _graph(
     return graph, time.perf_counter() - t0
 
 
+def budget_share(graph: ZoneGraph, simplified: bool) -> float:
+    """The share of the remaining budget a graph's search gets: half for a simplified graph with a
+    face loop (the full graph may still need the rest), else all of it (a simplified graph with no
+    face loop is the full graph, which is then skipped: its half used to go unspent)."""
+    return FIRST_SHARE if simplified and bool(graph.surface_strip.any()) else 1.0
+
+
 def reconstruct(
     target_path: str | Path, config: InferConfig = InferConfig(), saved_graph: str | Path | None = None
 ) -> Reconstruction:
@@ -135,7 +142,7 @@ def reconstruct(
         build_s += seconds
         left = config.budget_s - search_s
         gen = ProposalGenerator(graph, level=config.level)
-        result = search(graph, ranker, _search_config(config, left * FIRST_SHARE if simplify else left), gen)
+        result = search(graph, ranker, _search_config(config, left * budget_share(graph, simplify)), gen)
         if best is None or (result.iou, -len(result.steps)) > (best[2].iou, -len(best[2].steps)):
             trace += _improvements(result, search_s, best[2].iou if best else -1.0)
             best = (graph, gen, result)
