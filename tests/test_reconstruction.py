@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -187,3 +188,11 @@ def test_a_graph_without_face_loops_gets_the_whole_budget(samples_dir):
     assert budget_share(graph("Couch.json"), simplified=True) == 1.0  # no face loop
     assert budget_share(graph("Hexagon.json"), simplified=True) == FIRST_SHARE  # the full graph may follow
     assert budget_share(graph("Hexagon.json", simplify=False), simplified=False) == 1.0
+
+
+@requires_samples
+def test_exported_scripts_write_no_float_noise_around_zero(inferred):
+    for name, (_, out, _) in inferred.items():
+        text = (out / "sequence.py").read_text()
+        assert not re.search(r"\de-(1\d|[2-9]\d)\b", text), name  # nothing from 1e-10 down
+        assert not re.search(r"[(, ]-0[,)]", text), name  # no negative zero

@@ -45,6 +45,7 @@ from zonegraph.sequence.proposals import Op
 # replay. A tight tolerance at a higher degree keeps the written curve on the original.
 SPLINE_DEGREE = 8
 SPLINE_TOL = 1e-7
+ZERO = 1e-9  # a written coordinate this close to zero is zero
 
 
 def step_frame(step: ProgramStep) -> Frame:
@@ -94,12 +95,19 @@ def face_loops(face: Face, frame: Frame) -> list[tuple[bool, list[LocalEdge]]]:
 # --------------------------------------------------------------------------- build123d script
 
 
+def _num(x: float) -> str:
+    """A coordinate for people to read: float noise below 1e-9 (far under OpenCASCADE's 1e-7
+    tolerance) is written as 0, and never as -0."""
+    x = float(x)
+    return "0" if abs(x) < ZERO else f"{x:.12g}"
+
+
 def _xy(p: np.ndarray) -> str:
-    return f"({p[0]:.12g}, {p[1]:.12g})"
+    return f"({_num(p[0])}, {_num(p[1])})"
 
 
 def _vec(v: Sequence[float] | np.ndarray) -> str:
-    return "(" + ", ".join(f"{float(c):.12g}" for c in v) + ")"
+    return "(" + ", ".join(_num(c) for c in v) + ")"
 
 
 def _edge_code(e: LocalEdge) -> str:
