@@ -12,6 +12,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+import pyarrow.dataset as ds
+
 from zonegraph.data.dataset import project_of
 
 
@@ -33,3 +35,10 @@ def trained_projects(models: Sequence[str | Path]) -> tuple[set[str], list[str]]
 def held_out(design_ids: Iterable[str], projects: set[str]) -> list[str]:
     """The designs whose project is not in ``projects``, in their order."""
     return [d for d in design_ids if project_of(d) not in projects]
+
+
+def held_out_labelled(labels_dir: str | Path, split: str, projects: set[str]) -> list[str]:
+    """The designs of ``split`` with label shards, by id, less those of ``projects``."""
+    steps = ds.dataset(Path(labels_dir) / "steps", format="parquet").to_table(columns=["design_id", "split"])
+    ids = steps.filter(ds.field("split") == split).column("design_id").to_pylist()
+    return held_out(sorted(set(ids)), projects)

@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from eval.curves import curves, plot_curves, time_grid
-from eval.heldout import held_out, trained_projects
+from eval.heldout import held_out, held_out_labelled, trained_projects
 from eval.programs import program_measures
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
@@ -77,7 +77,8 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
         return pd.DataFrame(), "No rank-only labels for these designs: the rank needs the labels stage.\n"
     rankers = make_guides(["random", "heuristic"], [g.model for g in guides if g.model], args.seed)
     rankers = {g.name: r for g, r in zip(guides, rankers.values(), strict=True)}
-    ranks = guide_ranks(labels, graphs, rankers, args.designs, _rank_designs(labels, args))
+    designs = held_out_labelled(labels, args.designs, args.trained)[: args.limit]
+    ranks = guide_ranks(labels, graphs, rankers, args.designs, designs)
     ranks.to_parquet(out / "ranks.parquet", index=False)
     table = summarise(ranks, seed=args.seed)
     plot_ranks(table, out / "rank.png")
@@ -88,13 +89,6 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
         per = ranks.groupby(["folder", "guide"], sort=True)["rank"].mean().unstack("guide")
         text += "\nBy timeline folder (mean rank):\n\n" + _frame_md(per[table["guide"]]) + "\n"
     return table, text
-
-
-def _rank_designs(labels: Path, args: argparse.Namespace) -> list[str]:
-    """The split's labelled designs, less the models' training projects, the first ``--limit``."""
-    steps = pd.read_parquet(labels / "steps", columns=["design_id", "split"])
-    ids = held_out(sorted(set(steps.loc[steps["split"] == args.designs, "design_id"])), args.trained)
-    return ids[: args.limit]
 
 
 def _folders(args: argparse.Namespace) -> dict[str, str]:

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import yaml
 
-from eval.heldout import held_out, trained_projects
+from eval.heldout import held_out_labelled, trained_projects
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
 from training.train import TrainConfig, train
 
@@ -49,16 +49,6 @@ def train_variant(name: str, config: TrainConfig, out: Path) -> Path:
     return checkpoint
 
 
-def test_designs(labels: str, models: list[Path], limit: int) -> list[str]:
-    """The first ``limit`` labelled test designs of projects no variant trained on."""
-    import pandas as pd
-
-    steps = pd.read_parquet(Path(labels) / "steps", columns=["design_id", "split"])
-    ids = sorted(set(steps.loc[steps["split"] == "test", "design_id"]))
-    projects, _ = trained_projects(models)
-    return held_out(ids, projects)[:limit]
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--params", default="params.yaml")
@@ -77,7 +67,7 @@ def main() -> None:
     )
     args.out.mkdir(parents=True, exist_ok=True)
     models = [train_variant(name, config, args.out) for name, config in variants(base, args.rounds).items()]
-    designs = test_designs(base.labels_dir, models, args.eval_designs)
+    designs = held_out_labelled(base.labels_dir, "test", trained_projects(models)[0])[: args.eval_designs]
     guides = make_guides(["random", "heuristic"], models, base.seed)
     ranks = guide_ranks(base.labels_dir, base.graphs_dir, guides, "test", designs)
     ranks.to_parquet(args.out / "ranks.parquet", index=False)
