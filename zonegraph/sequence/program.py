@@ -8,13 +8,17 @@ and compared with the target by OpenCASCADE Booleans: that B-rep IoU is the hone
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 from build123d import Face, Shape, Solid, Vector
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+from OCP.ShapeFix import ShapeFix_Shape
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 
-from zonegraph.geometry.occ import ancestors, make_compound
+from zonegraph.geometry.occ import ancestors, make_compound, shape_list
 from zonegraph.geometry.shapes import volume_of
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
@@ -32,10 +36,17 @@ class ProgramStep:
     distance: float
 
     def tool(self) -> Solid:
-        """The extruded sketch faces (fused when there are several)."""
+        """The extruded sketch faces (fused when there are several).
+
+        A face is first turned to face the extrusion direction: a prism swept against its
+        face's normal is an inside-out solid that the checker rejects and Booleans mishandle."""
         d = Vector(*self.direction) * self.distance
-        solids = [Solid.extrude(f, d) for f in self.faces]
+        solids = [Solid.extrude(_facing(f, d), d) for f in self.faces]
         return solids[0] if len(solids) == 1 else solids[0].fuse(*solids[1:]).clean()
+
+
+def _facing(face: Face, d: Vector) -> Face:
+    return face if face.normal_at().dot(d) >= 0 else Face(face.wrapped.Reversed())
 
 
 def partition_faces(graph: ZoneGraph) -> list:
@@ -92,43 +103,96 @@ class RebuildError(RuntimeError):
 
 
 def execute(program: list[ProgramStep]) -> list[Shape | None]:
-    """The shape after each step: the first union starts the part, then unions and subtractions."""
+    """The shape after each step: the first union starts the part, then unions and subtractions.
+
+    An invalid Boolean result (a union of two prisms sharing a cylindrical wall, on the corpus)
+    makes every later Boolean, and the final IoU, come back empty: each step keeps the first
+    valid result of the alternatives in :func:`_combine`."""
     shape: Shape | None = None
     states = []
     for i, step in enumerate(program):
         tool = step.tool()
-        try:
-            if shape is None:
-                shape = tool if step.op is Op.UNION else None
-            elif step.op is Op.UNION:
-                shape = shape.fuse(tool).clean()
-            else:
-                shape = shape.cut(tool).clean()
-        except ValueError as exc:  # build123d's word for a null Boolean result
-            raise RebuildError(f"step {i + 1}: Boolean failed ({exc})") from None
+        if shape is None:
+            shape = tool if step.op is Op.UNION else None
+        else:
+            shape = _combine(shape, tool, step.op, i)
         states.append(shape)
     return states
 
 
-def brep_iou(a: Shape | None, b: Shape) -> float:
-    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans (the common part, else a - b).
+# Fuzzy values of the rebuild's Booleans, as shares of the part's bounding-box diagonal, tried in
+# turn after an exact Boolean fails or returns an invalid solid.
+FUZZY_SHARES = (0.0, 1e-7, 1e-5)
 
-    A common of two nearly coincident solids with B-spline faces can come back empty on the first
-    call (the Boolean then fixes tolerances in place and a second call succeeds): an empty common
-    is therefore measured again through the difference, and only when both fail is IoU unknown."""
+
+def _combine(shape: Shape, tool: Shape, op: Op, index: int) -> Shape:
+    """``shape`` fused with or cut by ``tool``: exactly with the tool as built, then repaired, then
+    with fuzzy values; the first valid result wins, else the first result repaired. A step whose
+    Booleans all fail raises RebuildError."""
+    diag = float(shape.bounding_box().diagonal)
+    results = []
+    for x, share in [(tool, 0.0), (_repaired(tool), 0.0)] + [(tool, f) for f in FUZZY_SHARES[1:]]:
+        result = _boolean(shape, x, op, share * diag)
+        if result is not None and result.is_valid:
+            return result
+        if result is not None:
+            results.append(result)
+    if not results:
+        raise RebuildError(f"step {index + 1}: {op.name.lower()} failed (exact, fuzzy, repaired tool)")
+    return _repaired(results[0])
+
+
+def _boolean(shape: Shape, tool: Shape, op: Op, fuzzy: float) -> Shape | None:
+    """One OpenCASCADE fuse or cut, cleaned; None when it fails or comes back empty."""
+    algo = BRepAlgoAPI_Fuse() if op is Op.UNION else BRepAlgoAPI_Cut()
+    algo.SetArguments(shape_list([shape.wrapped]))
+    algo.SetTools(shape_list([tool.wrapped]))
+    algo.SetFuzzyValue(fuzzy)
+    algo.SetRunParallel(False)
+    algo.Build()
+    if not algo.IsDone() or algo.Shape().IsNull():
+        return None
+    result = Shape.cast(algo.Shape())
+    return result.clean() if result.volume > 0 else None
+
+
+def _repaired(shape: Shape) -> Shape:
+    fix = ShapeFix_Shape(shape.wrapped)
+    fix.Perform()
+    return Shape.cast(fix.Shape())
+
+
+def brep_iou(a: Shape | None, b: Shape) -> float:
+    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans.
+
+    A Boolean common of two coincident solids can come back empty although both are valid, and
+    which call fails depends on the argument order (on the corpus: common(program, target) empty,
+    common(target, program) whole), on a repair of one operand or on a fresh copy of the other.
+    A failed common loses volume, it does not invent it, so the largest of these is the
+    intersection; the next is tried only while the last fell short of the smaller solid."""
     if a is None:
         return 0.0
-    try:
-        inter = volume_of(a.intersect(b))
-    except ValueError:  # a null Boolean result: measure the same thing through the difference
-        inter = 0.0
-    if inter <= 0.0:
-        try:
-            rest = a.cut(b)
-        except ValueError:
-            raise RebuildError("Booleans against the target failed; IoU unknown") from None
-        inter = a.volume - volume_of(rest)
     volume_a, volume_b = a.volume, b.volume
+    full = (1 - 1e-9) * min(volume_a, volume_b)
+    inter = 0.0
+    for x, y in _common_operands(a, b):
+        inter = max(inter, _common_volume(x, y))
+        if inter >= full:
+            break
     inter = min(inter, volume_a, volume_b)  # volume integration error can exceed an operand's volume
     union = volume_a + volume_b - inter
     return inter / union if union > 0 else 1.0
+
+
+def _common_operands(a: Shape, b: Shape) -> Iterator[tuple[Shape, Shape]]:
+    yield a, b
+    yield b, a
+    yield _repaired(a), b
+    yield a, Shape.cast(BRepBuilderAPI_Copy(b.wrapped).Shape())
+
+
+def _common_volume(a: Shape, b: Shape) -> float:
+    try:
+        return volume_of(a.intersect(b))
+    except ValueError:  # a null Boolean result
+        return 0.0

@@ -1,0 +1,28 @@
+"""Real corpus designs for tests: converted from ``../shared/data/fusion360_b123d`` and replayed.
+
+The corpus is never copied into the repository; tests that use it skip when it is absent.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import pytest
+from build123d import Shape
+
+from zonegraph.data.b123d import convert_design
+from zonegraph.data.design import parse_design
+from zonegraph.data.replay import replay
+
+CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "fusion360_b123d"
+SKIP_REASON = f"build123d script corpus not found at {CORPUS} (clone with ../shared beside the repo)"
+requires_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason=SKIP_REASON)
+
+
+@functools.cache
+def corpus_shape(batch: str, design_id: str) -> Shape:
+    """The final shape of one corpus design (``batch`` relative to the corpus root)."""
+    converted = convert_design(CORPUS / batch, design_id, timeout_s=120)
+    assert converted.ok and converted.design_json is not None, converted.reason
+    return replay(parse_design(converted.design_json, design_id)).shape
