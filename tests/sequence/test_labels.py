@@ -77,9 +77,12 @@ def test_plate_with_two_holes_alternative_order_is_neutral_and_a_wrong_cut_negat
 
 
 def test_every_dead_end_is_negative():
-    # Plate with one hole, at the cut: the only other proposal removes the plate's web, and its
-    # inverse (adding the web back) is banned, so no completion reaches the target.
-    graph, _, steps = _labelled(PLATE - HOLE_A, [PLATE, HOLE_A], ["new_body", "cut"], multiplier=20)
+    # Plate with one hole, at the cut, with no slack: the other proposal removes the plate's web,
+    # its inverse (adding the web back) is banned, and the plate extruded again from a side face
+    # (a prism across the hole's wall) needs a step more than the design has: no completion.
+    graph, _, steps = _labelled(
+        PLATE - HOLE_A, [PLATE, HOLE_A], ["new_body", "cut"], slack=0, multiplier=20
+    )
     _check_invariants(graph, steps)
     others = _others(steps[1])
     assert others and all(x.p == 0.0 and x.label == NEGATIVE for x in others)

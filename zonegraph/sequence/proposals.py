@@ -10,7 +10,8 @@ partition faces on s are grouped by the zone just beyond them along d:
 A sketch is a connected component of a group (faces sharing an edge on s), the union of the
 group's components, or (proposal level k) any 1..k or N-k..N of them. Each sketch face is swept
 along d to e through the zones it meets: from the face into the zone beyond it, then across that
-zone's caps (faces facing along d), never its side walls, until plane e. The zones swept must fill
+zone's caps (planar faces facing along d, and curved faces not on a cylinder or extrusion along d),
+never its side walls (cylinders and extrusions along d), until plane e. The zones swept must fill
 the prism exactly (volume = face area x |d|, relative 1e-4); a face that fails rejects the whole
 sketch. Sweeps are memoised per (face, s, e): the geometry never changes during search.
 """
@@ -207,9 +208,15 @@ class ProposalGenerator:
                 if g.face_surface[f] == e:
                     continue
                 n = g.face_normal[f]
-                if not np.isfinite(n[0]):
-                    continue  # curved faces are side walls here
                 fa, fb = g.face_zones[f]
+                if not np.isfinite(n[0]):  # a curved face: a side wall only if it runs along d
+                    if self._runs_along(f, d / length):
+                        continue
+                    other = fb if fa == z else fa
+                    if other < 0:
+                        return None
+                    stack.append(int(other))
+                    continue
                 outward = n if fa == z else -n  # face normals point from zone a to zone b
                 if float(outward @ d) > PARALLEL_TOL * length:
                     other = fb if fa == z else fa
@@ -222,6 +229,13 @@ class ProposalGenerator:
         ):
             return None
         return zones
+
+    def _runs_along(self, face: int, d: np.ndarray) -> bool:
+        """Whether a curved face lies on a cylinder or extrusion whose axis is parallel to ``d``."""
+        surface = int(self.graph.face_surface[face])
+        if surface < 0 or self.graph.surface_kind[surface] not in ("cylinder", "extrusion"):
+            return False
+        return 1 - abs(float(self.graph.surface_axis[surface, 3:] @ d)) < PARALLEL_TOL
 
     # ------------------------------------------------------------------------ proposals
 
