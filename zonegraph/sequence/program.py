@@ -12,9 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from build123d import Face, Shape, Solid, Vector
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 
-from zonegraph.geometry.occ import ancestors, make_compound
+from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, volume_props
 from zonegraph.geometry.shapes import volume_of
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
@@ -110,24 +111,39 @@ def execute(program: list[ProgramStep]) -> list[Shape | None]:
     return states
 
 
-def brep_iou(a: Shape | None, b: Shape) -> float:
+def _common_volume(a: Shape, b: Shape, fuzzy: float) -> float:
+    if fuzzy <= 0.0:
+        return volume_of(a.intersect(b))
+    return volume_props(fuzzy_boolean(BRepAlgoAPI_Common(), a.wrapped, b.wrapped, fuzzy))[0]
+
+
+def _cut_volume(a: Shape, b: Shape, fuzzy: float) -> float:
+    if fuzzy <= 0.0:
+        return volume_of(a.cut(b))
+    return volume_props(fuzzy_boolean(BRepAlgoAPI_Cut(), a.wrapped, b.wrapped, fuzzy))[0]
+
+
+def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     """vol(a and b) / vol(a or b) with OpenCASCADE Booleans (the common part, else a - b).
 
     A common of two nearly coincident solids with B-spline faces can come back empty on the first
     call (the Boolean then fixes tolerances in place and a second call succeeds): an empty common
-    is therefore measured again through the difference, and only when both fail is IoU unknown."""
+    is therefore measured again through the difference, and only when both fail is IoU unknown.
+    ``fuzzy`` > 0 takes faces closer than that as one: for a part meant to lie that close to the
+    other (an export with snapped numbers), whose plain common of faces a hair apart can come
+    back with almost no volume."""
     if a is None:
         return 0.0
     try:
-        inter = volume_of(a.intersect(b))
+        inter = _common_volume(a, b, fuzzy)
     except ValueError:  # a null Boolean result: measure the same thing through the difference
         inter = 0.0
     if inter <= 0.0:
         try:
-            rest = a.cut(b)
+            rest = _cut_volume(a, b, fuzzy)
         except ValueError:
             raise RebuildError("Booleans against the target failed; IoU unknown") from None
-        inter = a.volume - volume_of(rest)
+        inter = a.volume - rest
     volume_a, volume_b = a.volume, b.volume
     inter = min(inter, volume_a, volume_b)  # volume integration error can exceed an operand's volume
     union = volume_a + volume_b - inter
