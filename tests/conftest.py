@@ -1,4 +1,5 @@
-"""Shared fixtures: the real Fusion 360 Gallery samples from ../shared (skipped when absent)."""
+"""Shared fixtures: the real Fusion 360 Gallery samples and the build123d script corpus from ../shared
+(skipped when absent)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,10 @@ def samples_dir() -> Path:
 
 
 requires_samples = pytest.mark.skipif(not SAMPLES.is_dir(), reason=SKIP_REASON)
+
+CORPUS = SAMPLES.parent / "fusion360_b123d"
+CORPUS_SKIP_REASON = f"build123d script corpus not found at {CORPUS} (clone with ../shared beside the repo)"
+requires_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason=CORPUS_SKIP_REASON)
 
 
 def gt_rows(steps, level: int = 1) -> list[dict]:

@@ -6,18 +6,15 @@ The corpus is never copied into the repository; tests that use it skip when it i
 from __future__ import annotations
 
 import functools
-from pathlib import Path
 
-import pytest
 from build123d import Shape
 
+from tests.conftest import CORPUS, requires_corpus
 from zonegraph.data.b123d import convert_design
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
 
-CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "fusion360_b123d"
-SKIP_REASON = f"build123d script corpus not found at {CORPUS} (clone with ../shared beside the repo)"
-requires_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason=SKIP_REASON)
+__all__ = ["corpus_shape", "requires_corpus"]
 
 
 @functools.cache

@@ -21,6 +21,7 @@ from build123d import Solid, Unit
 from zonegraph.configs import InferConfig
 from zonegraph.data.replay import as_shape
 from zonegraph.data.targets import load_target
+from zonegraph.export.verify import Export, verified_export
 from zonegraph.export.writers import write_outputs
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.program import RebuildError, brep_iou, build_program, execute
@@ -67,6 +68,11 @@ class InferResult:
     zones: int
     simplified: bool
     expansions: int
+    script_snapped: bool = False  # sequence.py/.json carry snapped numbers (they rebuilt as well)
+    snapped_numbers: int = 0  # numbers written shorter than the raw program's
+    script_iou: float = 0.0  # B-rep IoU of the written sequence.py, run as written
+    json_iou: float = 0.0  # B-rep IoU of the written sequence.json, replayed by our reader
+    export_error: str = ""  # why a written file did not rebuild
     operations: list[str] = field(default_factory=list)  # union / subtract, in program order
     step_zones: list[list[int]] = field(default_factory=list)  # each step's extrusion zones (its graph)
     rebuild_error: str = ""
@@ -163,6 +169,19 @@ def _improvements(result: SearchResult, offset: float, above: float) -> list[tup
     return points or [(offset + result.time_to_best_s, result.iou)]
 
 
+def _export_fields(export: Export | None) -> dict[str, Any]:
+    """result.json's account of the written files (none written: nothing snapped, IoU 0)."""
+    if export is None:
+        return {}
+    return {
+        "script_snapped": export.snapped,
+        "snapped_numbers": export.snapped_numbers,
+        "script_iou": export.check.script_iou,
+        "json_iou": export.check.json_iou,
+        "export_error": export.check.error,
+    }
+
+
 def infer(
     target_path: str | Path,
     out: str | Path,
@@ -175,6 +194,8 @@ def infer(
     Args:
         target_path: a STEP, BREP or design JSON file.
         out: output folder (result.json, sequence.py/.json, and when ``render`` steps/ and a PNG).
+            The script and JSON carry snapped numbers when they rebuild the part as well as the
+            raw ones (:func:`zonegraph.export.verify.verified_export`).
         config: search settings.
         render: write the per-step STEP files and the PNG (the pipeline's bulk runs skip them).
         saved_graph: a folder holding this target's zone graph, reused instead of rebuilt.
@@ -195,8 +216,11 @@ def infer(
         iou = brep_iou(states[-1] if states else None, as_shape(rec.solids))
     except RebuildError as exc:
         rebuild_error = str(exc)
+    export: Export | None = None
     if states:
-        write_outputs(program, states, out_dir, path.stem, input_unit(path), render)
+        unit = input_unit(path)
+        export = verified_export(program, path.stem, unit, as_shape(rec.solids), iou, EXACT_IOU)
+        write_outputs(export.script, export.design, program, states, out_dir, unit, render)
     exact = bool(rec.result.exact and iou >= EXACT_IOU)
     result = InferResult(
         status="rebuild_failed" if rebuild_error else "exact" if exact else "partial",
@@ -210,6 +234,7 @@ def infer(
         zones=rec.graph.n_zones,
         simplified=bool(rec.graph.info["simplified"]),
         expansions=rec.result.expansions,
+        **_export_fields(export),
         operations=[s.op.name.lower() for s in program],
         step_zones=[[int(z) for z in np.flatnonzero(p.zones)] for p in rec.result.steps],
         rebuild_error=rebuild_error,

@@ -13,14 +13,11 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import CORPUS, requires_corpus
 from zonegraph.data.b123d import ConvertedDesign, CorpusEntry, convert_batch, convert_design, list_corpus
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
-
-CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "fusion360_b123d"
-SKIP_REASON = f"build123d script corpus not found at {CORPUS} (clone with ../shared beside the repo)"
-requires_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason=SKIP_REASON)
 
 STATUSES = {
     "ok",

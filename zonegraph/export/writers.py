@@ -1,8 +1,10 @@
 """Write a program out: an editable build123d script, Fusion-format JSON, STEP per step, a PNG strip.
 
-Sketch curves are written in each sketch's own frame (origin on the start plane, z along the
+Sketch curves are written in each sketch's own frame (origin: the start plane's point nearest the
+input's origin, so a sketch on a principal plane reads in the input's own coordinates; z along the
 extrusion), lines as lines, circular arcs and circles exactly, any other curve as a B-spline (JSON)
-or an interpolating spline through points (script).
+or an interpolating spline through points (script). The script and the JSON are both written from
+one list of :class:`WrittenStep`, whose numbers a :class:`~zonegraph.export.snap.Snapper` chose.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ from zonegraph.data.design import (
     design_to_json,
 )
 from zonegraph.export.render import render_sequence
+from zonegraph.export.snap import Snapper, written
 from zonegraph.geometry.shapes import write_step
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.program import ProgramStep
@@ -45,15 +48,22 @@ from zonegraph.sequence.proposals import Op
 # replay. A tight tolerance at a higher degree keeps the written curve on the original.
 SPLINE_DEGREE = 8
 SPLINE_TOL = 1e-7
-ZERO = 1e-9  # a written coordinate this close to zero is zero
+SPLINE_SAMPLES = 24  # points the script's interpolating spline runs through
 
 
-def step_frame(step: ProgramStep) -> Frame:
-    z = np.asarray(step.direction, float)
+def step_frame(step: ProgramStep, snap: Snapper | None = None) -> Frame:
+    """The sketch frame of a step, with its numbers snapped.
+
+    x is the principal axis least along z, made orthogonal to z; after snapping, x is made
+    orthogonal to the snapped z again, so the frame stays orthonormal."""
+    snap = snap or Snapper.raw()
+    z = snap.direction(step.direction)
     helper = np.eye(3)[int(np.argmin(np.abs(z)))]
-    x = helper - z * float(helper @ z)
+    x = snap.direction(helper - z * float(helper @ z))
+    x = x - z * float(x @ z)
     x /= np.linalg.norm(x)
-    return Frame(step.origin, tuple(x), tuple(np.cross(z, x)), tuple(z))
+    origin = snap.point(z * float(np.asarray(step.origin, float) @ z))
+    return Frame(vec3(origin), vec3(x), vec3(np.cross(z, x) + 0.0), vec3(z))
 
 
 def _local(frame: Frame, p: Sequence[float] | np.ndarray | Vector) -> np.ndarray:
@@ -62,24 +72,59 @@ def _local(frame: Frame, p: Sequence[float] | np.ndarray | Vector) -> np.ndarray
 
 @dataclass(frozen=True)
 class LocalEdge:
-    """An edge in sketch coordinates: kind is line, arc, circle or spline (with sample points)."""
+    """An edge in sketch coordinates, as the script writes it (kind, points, radius) and as the
+    JSON does (``curve``). kind is line, arc, circle or spline; ``points``: line: start, end;
+    arc: start, mid, end; circle: centre; spline: samples (the script interpolates them)."""
 
     kind: str
-    points: np.ndarray  # line: start, end; arc: start, mid, end; circle: centre; spline: samples
+    points: np.ndarray
+    curve: Curve
     radius: float = 0.0
 
 
-def local_edges(edge: Edge, frame: Frame) -> LocalEdge:
+def _arc(edge: Edge, frame: Frame, snap: Snapper) -> LocalEdge:
+    """Start, mid and end point (the script's ThreePointArc); centre and radius (the JSON's arc),
+    each snapped like any other number; the JSON's reference direction is a snapped unit vector."""
+    points = [snap.point(_local(frame, edge.position_at(t))) for t in (0, 0.5, 1)]
+    centre = snap.point(_local(frame, edge.arc_center))
+    radius = snap.length(edge.radius)
+    a, m, b = (q - centre for q in points)
+    sign = 1.0 if a[0] * m[1] - a[1] * m[0] > 0 else -1.0
+    ref = snap.direction(a)
+    perp = np.cross((0.0, 0.0, sign), ref)
+    sweep = math.atan2(float(b @ perp), float(b @ ref)) % (2 * math.pi) or 2 * math.pi
+    arc = Arc(vec3(points[0]), vec3(points[2]), vec3(centre), radius, (0.0, 0.0, sign), 0.0, sweep, vec3(ref))
+    return LocalEdge("arc", np.array(points), arc, radius)
+
+
+def _nurbs(edge: Edge, frame: Frame) -> Nurbs:
+    """The JSON's B-spline of a free-form edge, in the (snapped) sketch frame. Its poles are not
+    snapped: nobody edits them, and moving the curve off the original would buy nothing."""
+    spline = edge.to_splines(degree=SPLINE_DEGREE, tolerance=SPLINE_TOL)
+    geom = spline.geom_adaptor().BSpline()
+    poles = [_local(frame, (q.X(), q.Y(), q.Z())) for q in geom.Poles()]
+    knots = [k for k, m in zip(geom.Knots(), geom.Multiplicities(), strict=False) for _ in range(m)]
+    weights = list(geom.Weights()) if geom.IsRational() else None
+    return Nurbs(
+        geom.Degree(), tuple(knots), tuple(vec3(q) for q in poles), tuple(weights) if weights else None
+    )
+
+
+def local_edge(edge: Edge, frame: Frame, snap: Snapper | None = None) -> LocalEdge:
+    """An edge of a sketch face in the sketch's frame, its numbers snapped."""
+    snap = snap or Snapper.raw()
     kind = edge.geom_type
     if kind == GeomType.LINE:
-        return LocalEdge("line", np.array([_local(frame, edge.position_at(t)) for t in (0, 1)]))
+        ends = [snap.point(_local(frame, edge.position_at(t))) for t in (0, 1)]
+        return LocalEdge("line", np.array(ends), Line(vec3(ends[0]), vec3(ends[1])))
+    if kind == GeomType.CIRCLE and edge.is_closed:
+        centre = snap.point(_local(frame, edge.arc_center))
+        radius = snap.length(edge.radius)
+        return LocalEdge("circle", np.array([centre]), Circle(vec3(centre), radius, (0.0, 0.0, 1.0)), radius)
     if kind == GeomType.CIRCLE:
-        if edge.is_closed:
-            return LocalEdge("circle", np.array([_local(frame, edge.arc_center)]), edge.radius)
-        return LocalEdge(
-            "arc", np.array([_local(frame, edge.position_at(t)) for t in (0, 0.5, 1)]), edge.radius
-        )
-    return LocalEdge("spline", np.array([_local(frame, edge.position_at(t)) for t in np.linspace(0, 1, 24)]))
+        return _arc(edge, frame, snap)
+    samples = [snap.point(_local(frame, edge.position_at(t))) for t in np.linspace(0, 1, SPLINE_SAMPLES)]
+    return LocalEdge("spline", np.array(samples), _nurbs(edge, frame))
 
 
 def face_wires(face: Face) -> list[tuple[bool, list[Edge]]]:
@@ -88,26 +133,41 @@ def face_wires(face: Face) -> list[tuple[bool, list[Edge]]]:
     return [(outer, list(w.edges())) for outer, w in wires if w.edges()]
 
 
-def face_loops(face: Face, frame: Frame) -> list[tuple[bool, list[LocalEdge]]]:
-    return [(outer, [local_edges(e, frame) for e in edges]) for outer, edges in face_wires(face)]
+@dataclass(frozen=True)
+class WrittenStep:
+    """One step with the numbers that go into the files: frame, loops per sketch face, distance."""
+
+    op: Op
+    frame: Frame
+    faces: tuple[tuple[tuple[bool, tuple[LocalEdge, ...]], ...], ...]  # per face: (is_outer, edges)
+    areas: tuple[float, ...]  # each sketch face's area (the JSON's profile area)
+    distance: float
+
+
+def written_steps(program: list[ProgramStep], snap: Snapper | None = None) -> list[WrittenStep]:
+    """The program in sketch coordinates, every number passed through ``snap`` once."""
+    snap = snap or Snapper.raw()
+    out = []
+    for step in program:
+        frame = step_frame(step, snap)
+        faces = tuple(
+            tuple((outer, tuple(local_edge(e, frame, snap) for e in edges)) for outer, edges in face_wires(f))
+            for f in step.faces
+        )
+        areas = tuple(f.area for f in step.faces)
+        out.append(WrittenStep(step.op, frame, faces, areas, snap.length(step.distance)))
+    return out
 
 
 # --------------------------------------------------------------------------- build123d script
 
 
-def _num(x: float) -> str:
-    """A coordinate for people to read: float noise below 1e-9 (far under OpenCASCADE's 1e-7
-    tolerance) is written as 0, and never as -0."""
-    x = float(x)
-    return "0" if abs(x) < ZERO else f"{x:.12g}"
-
-
 def _xy(p: np.ndarray) -> str:
-    return f"({_num(p[0])}, {_num(p[1])})"
+    return f"({written(p[0])}, {written(p[1])})"
 
 
 def _vec(v: Sequence[float] | np.ndarray) -> str:
-    return "(" + ", ".join(_num(c) for c in v) + ")"
+    return "(" + ", ".join(written(c) for c in v) + ")"
 
 
 def _edge_code(e: LocalEdge) -> str:
@@ -116,13 +176,31 @@ def _edge_code(e: LocalEdge) -> str:
     if e.kind == "arc":
         return f"ThreePointArc({_xy(e.points[0])}, {_xy(e.points[1])}, {_xy(e.points[2])})"
     if e.kind == "circle":
-        return f"CenterArc({_xy(e.points[0])}, {e.radius:.12g}, 0, 360)"
+        return f"CenterArc({_xy(e.points[0])}, {written(e.radius)}, 0, 360)"
     return "Spline(" + ", ".join(_xy(p) for p in e.points) + ")  # interpolates the original curve"
 
 
-def program_script(program: list[ProgramStep], name: str, unit: Unit) -> str:
+def _step_code(i: int, step: WrittenStep) -> list[str]:
+    frame = step.frame
+    verb = "union" if step.op is Op.UNION else "subtract"
     lines = [
-        f'"""{name}: {len(program)} sketch + extrude steps found by `zonegraph infer`.',
+        f"    # Step {i}: {verb}, extrude {written(step.distance)} along the sketch normal",
+        f"    with BuildSketch(Plane(origin={_vec(frame.origin)}, x_dir={_vec(frame.x_axis)}, "
+        f"z_dir={_vec(frame.z_axis)})):",
+    ]
+    for loops in step.faces:
+        for outer, edges in loops:
+            lines.append("        with BuildLine(mode=Mode.PRIVATE) as loop:")
+            lines += [f"            {_edge_code(e)}" for e in edges]
+            mode = "" if outer else ", mode=Mode.SUBTRACT"
+            lines.append(f"        make_face(loop.edges(){mode})")
+    mode = "Mode.ADD" if step.op is Op.UNION else "Mode.SUBTRACT"
+    return lines + [f"    extrude(amount={written(step.distance)}, mode={mode})", ""]
+
+
+def program_script(steps: list[WrittenStep], name: str, unit: Unit) -> str:
+    lines = [
+        f'"""{name}: {len(steps)} sketch + extrude steps found by `zonegraph infer`.',
         "",
         f"Units ({unit.name.lower()}) and position are the input's. Run `python sequence.py [out.step]`.",
         '"""',
@@ -133,26 +211,8 @@ def program_script(program: list[ProgramStep], name: str, unit: Unit) -> str:
         "",
         "with BuildPart() as part:",
     ]
-    for i, step in enumerate(program, 1):
-        frame = step_frame(step)
-        verb = "union" if step.op is Op.UNION else "subtract"
-        lines.append(f"    # Step {i}: {verb}, extrude {step.distance:.6g} along the sketch normal")
-        lines.append(
-            f"    with BuildSketch(Plane(origin={_vec(frame.origin)}, x_dir={_vec(frame.x_axis)}, "
-            f"z_dir={_vec(frame.z_axis)})):"
-        )
-        for face in step.faces:
-            for outer, edges in face_loops(face, frame):
-                lines.append("        with BuildLine(mode=Mode.PRIVATE) as loop:")
-                lines += [f"            {_edge_code(e)}" for e in edges]
-                lines.append(
-                    "        make_face(loop.edges())"
-                    if outer
-                    else "        make_face(loop.edges(), mode=Mode.SUBTRACT)"
-                )
-        mode = "Mode.ADD" if step.op is Op.UNION else "Mode.SUBTRACT"
-        lines.append(f"    extrude(amount={step.distance:.12g}, mode={mode})")
-        lines.append("")
+    for i, step in enumerate(steps, 1):
+        lines += _step_code(i, step)
     lines += [
         "result = part.part",
         "",
@@ -166,45 +226,18 @@ def program_script(program: list[ProgramStep], name: str, unit: Unit) -> str:
 # ------------------------------------------------------------------------- Fusion-format JSON
 
 
-def _curve(e: LocalEdge, edge: Edge, frame: Frame) -> Curve:
-    p = [vec3(q) for q in e.points]
-    if e.kind == "line":
-        return Line(p[0], p[1])
-    if e.kind == "circle":
-        return Circle(p[0], e.radius, (0.0, 0.0, 1.0))
-    if e.kind == "arc":
-        centre = _local(frame, edge.arc_center)
-        a, m, b = (np.asarray(q) - centre for q in e.points)
-        sign = 1.0 if a[0] * m[1] - a[1] * m[0] > 0 else -1.0
-        ref = a / np.linalg.norm(a)
-        perp = np.cross((0.0, 0.0, sign), ref)
-        sweep = math.atan2(float(b @ perp), float(b @ ref)) % (2 * math.pi) or 2 * math.pi
-        return Arc(p[0], p[2], vec3(centre), e.radius, (0.0, 0.0, sign), 0.0, sweep, vec3(ref))
-    spline = edge.to_splines(degree=SPLINE_DEGREE, tolerance=SPLINE_TOL)
-    geom = spline.geom_adaptor().BSpline()
-    poles = [_local(frame, (q.X(), q.Y(), q.Z())) for q in geom.Poles()]
-    knots = [k for k, m in zip(geom.Knots(), geom.Multiplicities(), strict=False) for _ in range(m)]
-    weights = list(geom.Weights()) if geom.IsRational() else None
-    return Nurbs(
-        geom.Degree(),
-        tuple(knots),
-        tuple(vec3(q) for q in poles),
-        tuple(weights) if weights else None,
-    )
-
-
-def program_design(program: list[ProgramStep], name: str) -> Design:
+def program_design(steps: list[WrittenStep], name: str) -> Design:
     timeline: list[Sketch | Extrude] = []
-    for i, step in enumerate(program):
-        frame = step_frame(step)
-        profiles = {}
-        for j, face in enumerate(step.faces):
-            loops = tuple(
-                Loop(outer, tuple(_curve(local_edges(e, frame), e, frame) for e in edges))
-                for outer, edges in face_wires(face)
+    for i, step in enumerate(steps):
+        profiles = {
+            f"profile{i}_{j}": Profile(
+                f"profile{i}_{j}",
+                tuple(Loop(outer, tuple(e.curve for e in edges)) for outer, edges in loops),
+                area,
             )
-            profiles[f"profile{i}_{j}"] = Profile(f"profile{i}_{j}", loops, face.area)
-        sketch = Sketch(f"sketch{i}", f"Sketch{i + 1}", frame, profiles)
+            for j, (loops, area) in enumerate(zip(step.faces, step.areas, strict=True))
+        }
+        sketch = Sketch(f"sketch{i}", f"Sketch{i + 1}", step.frame, profiles)
         op = (Operation.NEW_BODY if i == 0 else Operation.JOIN) if step.op is Op.UNION else Operation.CUT
         extrude = Extrude(
             f"extrude{i}",
@@ -218,20 +251,32 @@ def program_design(program: list[ProgramStep], name: str) -> Design:
     return Design(name, tuple(timeline))
 
 
+def design_text(steps: list[WrittenStep], name: str) -> str:
+    """``sequence.json``'s text."""
+    return json.dumps(design_to_json(program_design(steps, name)), indent=1)
+
+
 # ------------------------------------------------------------------------------ STEP and PNG
 
 
 def write_outputs(
-    program: list[ProgramStep], states: list[Shape], out: Path, name: str, unit: Unit, render: bool = True
+    script: str,
+    design: str,
+    program: list[ProgramStep],
+    states: list[Shape | None],
+    out: Path,
+    unit: Unit,
+    render: bool = True,
 ) -> None:
-    """sequence.py, sequence.json and, when ``render``, steps/NN.step and sequence.png.
+    """sequence.py and sequence.json (the texts given) and, when ``render``, steps/NN.step and
+    sequence.png of the program's own states.
 
     ``unit`` is what the input's numbers mean (mm for STEP as read, cm for a design JSON); the
     STEP files declare it, so they open at the input's size.
     """
     out.mkdir(parents=True, exist_ok=True)
-    (out / "sequence.py").write_text(program_script(program, name, unit))
-    (out / "sequence.json").write_text(json.dumps(design_to_json(program_design(program, name)), indent=1))
+    (out / "sequence.py").write_text(script)
+    (out / "sequence.json").write_text(design)
     if not render:
         return
     for i, state in enumerate(states):

@@ -7,6 +7,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepAlgoAPI import BRepAlgoAPI_BooleanOperation
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepGProp import BRepGProp
 from OCP.collections import (
@@ -70,6 +71,25 @@ def shape_list(shapes: Sequence[TopoDS_Shape]) -> ShapeList:
     for shape in shapes:
         out.Append(shape)
     return out
+
+
+def fuzzy_boolean(
+    operation: BRepAlgoAPI_BooleanOperation, a: TopoDS_Shape, b: TopoDS_Shape, fuzzy: float
+) -> TopoDS_Shape:
+    """``a`` (op) ``b`` with sub-shapes closer than ``fuzzy`` taken as coincident: two faces a
+    hair apart are OpenCASCADE's hardest Boolean case, which a fuzzy value turns into its easiest.
+
+    Raises:
+        ValueError: the Boolean reported errors.
+    """
+    operation.SetArguments(shape_list([a]))
+    operation.SetTools(shape_list([b]))
+    operation.SetFuzzyValue(fuzzy)
+    operation.SetRunParallel(False)
+    operation.Build()
+    if not operation.IsDone():
+        raise ValueError("fuzzy Boolean failed")
+    return operation.Shape()
 
 
 def shape_index(shape: TopoDS_Shape, kind: TopAbs_ShapeEnum) -> ShapeIndex:

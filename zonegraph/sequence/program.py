@@ -13,12 +13,12 @@ from dataclasses import dataclass
 
 import numpy as np
 from build123d import Face, Shape, Solid, Vector
-from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.ShapeFix import ShapeFix_Shape
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 
-from zonegraph.geometry.occ import ancestors, make_compound, shape_list
+from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, shape_list, volume_props
 from zonegraph.geometry.shapes import volume_of
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
@@ -162,21 +162,24 @@ def _repaired(shape: Shape) -> Shape:
     return Shape.cast(fix.Shape())
 
 
-def brep_iou(a: Shape | None, b: Shape) -> float:
+def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     """vol(a and b) / vol(a or b) with OpenCASCADE Booleans.
 
     A Boolean common of two coincident solids can come back empty although both are valid, and
     which call fails depends on the argument order (on the corpus: common(program, target) empty,
     common(target, program) whole), on a repair of one operand or on a fresh copy of the other.
     A failed common loses volume, it does not invent it, so the largest of these is the
-    intersection; the next is tried only while the last fell short of the smaller solid."""
+    intersection; the next is tried only while the last fell short of the smaller solid.
+    ``fuzzy`` > 0 takes faces closer than that as one: for a part meant to lie that close to the
+    other (an export with snapped numbers), whose plain common of faces a hair apart can come
+    back with almost no volume."""
     if a is None:
         return 0.0
     volume_a, volume_b = a.volume, b.volume
     full = (1 - 1e-9) * min(volume_a, volume_b)
     inter = 0.0
     for x, y in _common_operands(a, b):
-        inter = max(inter, _common_volume(x, y))
+        inter = max(inter, _common_volume(x, y, fuzzy))
         if inter >= full:
             break
     inter = min(inter, volume_a, volume_b)  # volume integration error can exceed an operand's volume
@@ -191,8 +194,10 @@ def _common_operands(a: Shape, b: Shape) -> Iterator[tuple[Shape, Shape]]:
     yield a, Shape.cast(BRepBuilderAPI_Copy(b.wrapped).Shape())
 
 
-def _common_volume(a: Shape, b: Shape) -> float:
+def _common_volume(a: Shape, b: Shape, fuzzy: float) -> float:
     try:
-        return volume_of(a.intersect(b))
-    except ValueError:  # a null Boolean result
+        if fuzzy <= 0.0:
+            return volume_of(a.intersect(b))
+        return volume_props(fuzzy_boolean(BRepAlgoAPI_Common(), a.wrapped, b.wrapped, fuzzy))[0]
+    except ValueError:  # a null or failed Boolean result
         return 0.0

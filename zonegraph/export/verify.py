@@ -1,0 +1,154 @@
+"""Rebuild what is written, and write snapped numbers only where they rebuild the part as well.
+
+Snapping moves each number by at most a millionth of the part, but a moved vertex can still close a
+gap, merge two edges or tip a Boolean, so nothing is assumed: the texts that go to disk are run
+themselves. The script is executed in a fresh namespace (its ``result``), the JSON is parsed and
+replayed by the project's own reader, and both are measured against the target with B-rep IoU. The
+snapped texts are kept when they are exact wherever the program was (or as good as the program's
+own rebuild), else when they are at least as good as the raw texts; otherwise the raw numbers are
+written, and the IoU recorded is always that of the texts written.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from build123d import Shape, Unit
+
+from zonegraph.data.design import parse_design
+from zonegraph.data.replay import replay
+from zonegraph.export.snap import REL_TOL, Snapper
+from zonegraph.export.writers import design_text, program_script, written_steps
+from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou
+
+IOU_SLACK = 1e-6  # volume-integration noise between two rebuilds of the same part
+# Written files are measured with faces closer than this fraction of the part's diagonal taken as
+# one: ten times what snapping may move (REL_TOL), far below any real change. Without it the
+# common of a snapped part and the target, faces 1e-6 apart, came back with 3e-7 of the volume.
+FUZZY_REL = 10 * REL_TOL
+
+
+@dataclass(frozen=True)
+class ExportCheck:
+    """B-rep IoU against the target of the written script and of the written JSON's replay
+    (faces closer than ``FUZZY_REL`` of the part's diagonal taken as one)."""
+
+    script_iou: float
+    json_iou: float
+    error: str = ""  # why a written file did not rebuild ("" when both did)
+
+    @property
+    def iou(self) -> float:
+        return min(self.script_iou, self.json_iou)
+
+
+@dataclass(frozen=True)
+class Export:
+    """The texts of sequence.py and sequence.json, whether their numbers were snapped, and how
+    they rebuild."""
+
+    script: str
+    design: str
+    snapped: bool
+    snapped_numbers: int  # numbers whose written text snapping changed (0 when not snapped)
+    check: ExportCheck
+
+
+def export_texts(program: list[ProgramStep], name: str, unit: Unit, snap: Snapper) -> tuple[str, str]:
+    """The script and JSON texts of a program, both from one pass of ``snap`` over its numbers."""
+    steps = written_steps(program, snap)
+    return program_script(steps, name, unit), design_text(steps, name)
+
+
+def run_script(text: str) -> Shape:
+    """The ``result`` of a written script, executed as a module that is not ``__main__``."""
+    namespace: dict[str, Any] = {"__name__": "zonegraph_written_script"}
+    exec(compile(text, "sequence.py", "exec"), namespace)
+    result = namespace.get("result")
+    if not isinstance(result, Shape):
+        raise ValueError("the script left no shape in `result`")
+    return result
+
+
+def _iou(shape: Shape, target: Shape, fuzzy: float) -> float:
+    """B-rep IoU with ``fuzzy``; where the fuzzy Booleans fail, the plain ones may not."""
+    try:
+        return brep_iou(shape, target, fuzzy)
+    except RebuildError:
+        return brep_iou(shape, target)
+
+
+def _measure(build: Callable[[], Shape], target: Shape, fuzzy: float, label: str) -> tuple[float, str]:
+    """IoU of ``build()`` against the target; any failure to rebuild is an IoU of 0 and its reason
+    (OCP's exceptions share no base class, so none is let through)."""
+    try:
+        return _iou(build(), target, fuzzy), ""
+    except Exception as exc:
+        return 0.0, f"{label}: {type(exc).__name__}: {exc}"
+
+
+def check_export(script: str, design: str, name: str, target: Shape) -> ExportCheck:
+    """Run the written script and replay the written JSON; measure both against the target, faces
+    closer than ``FUZZY_REL`` of its diagonal taken as one."""
+    fuzzy = FUZZY_REL * target.bounding_box().diagonal
+    script_iou, script_error = _measure(lambda: run_script(script), target, fuzzy, "sequence.py")
+    json_iou, json_error = _measure(
+        lambda: replay(parse_design(json.loads(design), name)).shape, target, fuzzy, "sequence.json"
+    )
+    return ExportCheck(script_iou, json_iou, "; ".join(e for e in (script_error, json_error) if e))
+
+
+def _snapper(target: Shape, rel: float) -> Snapper:
+    """A snapper for the target's size: its farthest point from the origin is a corner of its box."""
+    box = target.bounding_box()
+    corner = np.maximum(np.abs(tuple(box.min)), np.abs(tuple(box.max)))
+    return Snapper.for_part(box.diagonal, float(np.linalg.norm(corner)), rel)
+
+
+def as_good(snapped: ExportCheck, floor: float, raw: ExportCheck | None = None) -> bool:
+    """Whether snapped files may be written: each rebuilds to ``floor`` (exact wherever the
+    program was), or, measured beside the raw files, each is no worse than its raw twin."""
+    if snapped.error:
+        return False
+    pairs = [
+        (snapped.script_iou, raw.script_iou if raw else 1.0),
+        (snapped.json_iou, raw.json_iou if raw else 1.0),
+    ]
+    return all(iou >= min(floor, other - IOU_SLACK) for iou, other in pairs)
+
+
+def verified_export(
+    program: list[ProgramStep],
+    name: str,
+    unit: Unit,
+    target: Shape,
+    reference_iou: float,
+    exact_iou: float,
+    rel_tol: float = REL_TOL,
+) -> Export:
+    """The texts to write: snapped when their rebuild is as good as the unsnapped, else raw.
+
+    Args:
+        program: the found program, in the input's units.
+        name: the design's name (script docstring, JSON id).
+        unit: what the input's numbers mean.
+        target: the input's shape, in its units.
+        reference_iou: the B-rep IoU of the program's own rebuild.
+        exact_iou: the IoU from which a part counts as exact.
+        rel_tol: how far snapping may move a number, as a fraction of the part's diagonal.
+    """
+    snapper = _snapper(target, rel_tol)
+    script, design = export_texts(program, name, unit, snapper)
+    snapped = Export(
+        script, design, snapper.changed > 0, snapper.changed, check_export(script, design, name, target)
+    )
+    floor = min(reference_iou - IOU_SLACK, exact_iou)
+    if not snapped.snapped or as_good(snapped.check, floor):
+        return snapped
+    raw_script, raw_design = export_texts(program, name, unit, Snapper.raw())
+    raw = Export(raw_script, raw_design, False, 0, check_export(raw_script, raw_design, name, target))
+    return snapped if as_good(snapped.check, floor, raw.check) else raw
