@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from build123d import Box, Cylinder, Pos
@@ -100,15 +102,14 @@ def test_proposals_compare_and_hash_by_what_they_do():
     assert repr(props[0]).startswith("Proposal(union") and "zones" in repr(g)
 
 
-def test_zone_iou_is_at_most_one_and_one_only_on_the_target():
+def test_zone_iou_is_never_above_one():
     """Zones outside the target far smaller than the float rounding of the target's volume (the
     slivers of a fuzzy fuse): summed as one union they made a wrong canvas score above 1."""
-    graph = graph_of(Box(10, 10, 2) - Pos(2, 0, 0) * Cylinder(1, 2) - Pos(-3, 2, 0) * Box(2, 3, 2))
-    target = graph.zone_inside.astype(bool)
     rng = np.random.default_rng(0)
-    everything = np.ones(graph.n_zones, bool)
+    everything = np.ones(40, bool)
     for _ in range(200):
-        graph.zone_volume = np.where(target, rng.random(graph.n_zones), 1e-17 * rng.random(graph.n_zones))
-        iou = zone_iou(graph, everything, target)
-        assert iou <= 1.0
-    assert zone_iou(graph, target, target) == 1.0
+        target = rng.random(40) < 0.5
+        volumes = rng.random(40) * rng.choice([1, 1e-3, 1e-6], 40)
+        graph = SimpleNamespace(zone_volume=np.where(target, volumes, 1e-17 * volumes))
+        assert zone_iou(graph, everything, target) <= 1.0
+        assert zone_iou(graph, target, target) == 1.0
