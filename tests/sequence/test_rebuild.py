@@ -22,6 +22,10 @@ pytestmark = requires_corpus
         ("05_8to10ops/batch_001.py", "114429_70217b24_0000"),
         # four tools the checker rejects; the last cut fails unless fuzzy
         ("04_6to7ops/batch_003.py", "21236_b696e901_0041"),
+        # an invalid union that the next union still takes, unless it is repaired first
+        ("07_16to20ops/batch_001.py", "130022_505982e4_0000"),
+        # a valid rebuild whose exact commons with the target are all empty, in both orders
+        ("05_8to10ops/batch_009.py", "53471_1b48c608_0001"),
     ],
 )
 def test_a_zone_exact_program_rebuilds_exactly(batch, design_id, tmp_path):

@@ -126,20 +126,31 @@ FUZZY_SHARES = (0.0, 1e-7, 1e-5)
 
 
 def _combine(shape: Shape, tool: Shape, op: Op, index: int) -> Shape:
-    """``shape`` fused with or cut by ``tool``: exactly with the tool as built, then repaired, then
-    with fuzzy values; the first valid result wins, else the first result repaired. A step whose
-    Booleans all fail raises RebuildError."""
+    """``shape`` fused with or cut by ``tool``, trying in turn: the operands as they are, the tool
+    repaired, fuzzy values, and the part so far repaired. The first result the checker accepts
+    wins, else the first result as it came: an invalid part often still takes the next Booleans
+    (repairing one in place broke the next union on 4 corpus parts). A step whose Booleans all
+    fail raises RebuildError, which ``result.json`` reports."""
     diag = float(shape.bounding_box().diagonal)
-    results = []
-    for x, share in [(tool, 0.0), (_repaired(tool), 0.0)] + [(tool, f) for f in FUZZY_SHARES[1:]]:
-        result = _boolean(shape, x, op, share * diag)
+    first = None
+    for x, y, share in _alternatives(shape, tool):
+        result = _boolean(x, y, op, share * diag)
         if result is not None and result.is_valid:
             return result
-        if result is not None:
-            results.append(result)
-    if not results:
-        raise RebuildError(f"step {index + 1}: {op.name.lower()} failed (exact, fuzzy, repaired tool)")
-    return _repaired(results[0])
+        first = first or result
+    if first is None:
+        raise RebuildError(f"step {index + 1}: {op.name.lower()} failed (exact, fuzzy, repaired operands)")
+    return first
+
+
+def _alternatives(shape: Shape, tool: Shape) -> Iterator[tuple[Shape, Shape, float]]:
+    yield shape, tool, 0.0
+    if not tool.is_valid:
+        yield shape, _repaired(tool), 0.0
+    for share in FUZZY_SHARES[1:]:
+        yield shape, tool, share
+    if not shape.is_valid:
+        yield _repaired(shape), tool, 0.0
 
 
 def _boolean(shape: Shape, tool: Shape, op: Op, fuzzy: float) -> Shape | None:
@@ -178,8 +189,9 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     volume_a, volume_b = a.volume, b.volume
     full = (1 - 1e-9) * min(volume_a, volume_b)
     inter = 0.0
-    for x, y in _common_operands(a, b):
-        inter = max(inter, _common_volume(x, y, fuzzy))
+    tiny = max(fuzzy, 1e-9 * float(b.bounding_box().diagonal))
+    for x, y, value in _common_operands(a, b, fuzzy, tiny):
+        inter = max(inter, _common_volume(x, y, value))
         if inter >= full:
             break
     inter = min(inter, volume_a, volume_b)  # volume integration error can exceed an operand's volume
@@ -187,11 +199,14 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     return inter / union if union > 0 else 1.0
 
 
-def _common_operands(a: Shape, b: Shape) -> Iterator[tuple[Shape, Shape]]:
-    yield a, b
-    yield b, a
-    yield _repaired(a), b
-    yield a, Shape.cast(BRepBuilderAPI_Copy(b.wrapped).Shape())
+def _common_operands(a: Shape, b: Shape, fuzzy: float, tiny: float) -> Iterator[tuple[Shape, Shape, float]]:
+    """Both orders, exact then with a fuzzy value of 1e-9 of the part (a valid program whose exact
+    commons with the target were all empty took it), then a repaired part and a fresh target."""
+    for value in (fuzzy, tiny):
+        yield a, b, value
+        yield b, a, value
+    yield _repaired(a), b, fuzzy
+    yield a, Shape.cast(BRepBuilderAPI_Copy(b.wrapped).Shape()), fuzzy
 
 
 def _common_volume(a: Shape, b: Shape, fuzzy: float) -> float:
