@@ -32,9 +32,6 @@ from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.storage import load_zone_graph
 
 EXACT_IOU = 0.9999
-# A program whose canvas differs from the target only by zones this small a share of the volume
-# (slivers of the fuzzy fuse) is exact on zones: the B-rep IoU decides.
-ZONE_IOU_TOL = 1e-9
 FIRST_SHARE = 0.5  # of the budget, for the simplified graph
 
 
@@ -61,7 +58,7 @@ class InferResult:
     """What ``zonegraph infer`` found: the contents of ``result.json``."""
 
     status: str  # exact, partial or rebuild_failed
-    exact: bool  # exact on zones and rebuilt with B-rep IoU >= EXACT_IOU
+    exact: bool  # rebuilt with B-rep IoU >= EXACT_IOU (a zone sliver short of the target can be)
     iou_zone: float
     iou_brep: float
     steps: int
@@ -224,7 +221,7 @@ def infer(
         unit = input_unit(path)
         export = verified_export(program, path.stem, unit, as_shape(rec.solids), iou, EXACT_IOU)
         write_outputs(export.script, export.design, program, states, out_dir, unit, render)
-    exact = bool((rec.result.exact or rec.result.iou >= 1 - ZONE_IOU_TOL) and iou >= EXACT_IOU)
+    exact = bool(iou >= EXACT_IOU)  # the rebuilt B-rep decides, not the zones it was found on
     result = InferResult(
         status="rebuild_failed" if rebuild_error else "exact" if exact else "partial",
         exact=exact,
