@@ -1,21 +1,25 @@
-"""``zonegraph replay`` end to end, through the installed console script."""
+"""``zonegraph replay``, ``convert``, and batches of ``infer`` and ``build``, end to end."""
 
 from __future__ import annotations
 
 import json
 import math
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+from zonegraph.batch import collect_parts
 from zonegraph.cli import main
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.geometry.shapes import read_solids
 
 SCRIPT = Path(sys.executable).parent / "zonegraph"
+ROOT = Path(__file__).resolve().parents[1]  # run as ``python -m zonegraph.cli`` from here: this checkout
+KERNEL = ("build123d", "OCP", "scipy", "sklearn")
 
 
 @pytest.mark.skipif(
@@ -77,3 +81,89 @@ def test_convert_writes_verified_json_and_a_summary(tmp_path):
     assert [e.operation.name for e in design.extrudes] == ["NEW_BODY", "CUT"]
     assert replay(design).volume == pytest.approx(8 - 0.25 * math.pi, rel=1e-9)
     assert main(["convert", str(tmp_path / "missing"), "--out", str(tmp_path / "o2")]) == 2
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "zonegraph.cli", *args], cwd=ROOT, capture_output=True, text=True
+    )
+
+
+def test_batch_infer_writes_a_folder_per_part_and_a_summary(samples_dir, tmp_path):
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    for name in ("SingleSketchExtrude.json", "Pattern2_6c40bf33_0000.json", "Couch.json", "Couch.step"):
+        shutil.copy(samples_dir / name, parts / name)
+    (parts / "corrupt.step").write_text("ISO-10303-21;\nnot a STEP file\n")
+    (parts / "notes.txt").write_text("not a part")
+    out = tmp_path / "out"
+    proc = _cli("infer", str(parts), "--out", str(out), "--budget", "1")
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr
+    names = ["Couch", "Couch_2", "Pattern2_6c40bf33_0000", "SingleSketchExtrude", "corrupt"]
+    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == names  # stems; the .step copy: _2
+    summary = json.loads((out / "summary.json").read_text())
+    rows = {r["name"]: r for r in summary["parts"]}
+    assert [r["name"] for r in summary["parts"]] == names  # sorted files, in order
+    assert {n: rows[n]["status"] for n in names[:4]} == dict.fromkeys(names[:4], "exact")
+    assert rows["Couch_2"]["target"].endswith("Couch.step") and rows["Couch_2"]["iou_brep"] > 0.9999
+    assert rows["corrupt"]["status"] == "invalid_input" and not rows["corrupt"]["ok"]
+    assert rows["corrupt"]["reason"] and "\n" not in rows["corrupt"]["reason"]
+    assert summary["totals"]["by_status"] == {"exact": 4, "invalid_input": 1}
+    for name in names[:4]:
+        assert json.loads((out / name / "result.json").read_text())["steps"] == rows[name]["steps"]
+    assert json.loads((out / "corrupt" / "error.json").read_text())["status"] == "invalid_input"
+    table = proc.stdout.splitlines()
+    assert table[0].split()[:3] == ["part", "status", "steps"] and len(table) == 1 + len(names) + 1
+    assert "5 parts: 4 ran, 1 failed" in table[-1]
+
+
+def test_one_target_keeps_its_layout_and_several_files_make_a_batch(samples_dir, tmp_path):
+    """In subprocesses: the test process has run OpenCASCADE's thread pool, which a fork cannot use."""
+    one = tmp_path / "one"
+    proc = _cli("build", str(samples_dir / "SingleSketchExtrude.json"), "--out", str(one), "--samples", "0")
+    assert proc.returncode == 0, proc.stderr
+    assert (one / "zones.parquet").is_file()  # --out is the part's own folder, as before batches
+    files = [str(samples_dir / n) for n in ("SingleSketchExtrude.json", "Pattern2_6c40bf33_0000.json")]
+    several = tmp_path / "several"
+    proc = _cli("build", *files, "--out", str(several), "--samples", "0")
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads((several / "summary.json").read_text())
+    assert [(r["name"], r["status"], r["zones"]) for r in summary["parts"]] == [
+        ("SingleSketchExtrude", "ok", 1),
+        ("Pattern2_6c40bf33_0000", "ok", 12),
+    ]
+    assert (several / "Pattern2_6c40bf33_0000" / "zones.parquet").is_file()
+
+
+def test_a_folder_stands_for_its_part_files_and_equal_stems_get_numbers(tmp_path):
+    for name in ("b.step", "a.json", "a.STEP", "readme.md"):
+        (tmp_path / name).write_text("")
+    (tmp_path / "sub").mkdir()
+    parts = collect_parts([str(tmp_path), str(tmp_path / "b.step"), str(tmp_path / "absent.brep")])
+    assert [(p.name, p.path.name) for p in parts] == [
+        ("a", "a.STEP"),
+        ("a_2", "a.json"),
+        ("b", "b.step"),
+        ("b_2", "b.step"),
+        ("absent", "absent.brep"),  # kept, to fail as its own row
+    ]
+
+
+def test_help_and_argument_errors_load_no_geometry_kernel(tmp_path):
+    code = (
+        "import sys\n"
+        "from zonegraph.cli import main\n"
+        "for argv in (['--help'], ['infer', '--help'], ['infer'], ['build', 'x.step']):\n"
+        "    try:\n"
+        "        main(argv)\n"
+        "    except SystemExit:\n"
+        "        pass\n"
+        f"assert main(['infer', {str(tmp_path / 'absent.step')!r}, '--out', 'o']) == 2\n"
+        "assert main(['infer', 'x.step', '--out', 'o', '--guide', 'nope']) == 2\n"
+        f"print([m for m in {KERNEL!r} if m in sys.modules])\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().splitlines()[-1] == "[]"
+    assert "no such file" in proc.stderr and "unknown guide 'nope'" in proc.stderr

@@ -7,6 +7,7 @@ already imported OCP) that is killed at its deadline. The outcome is a status, n
 
 from __future__ import annotations
 
+import gc
 import multiprocessing as mp
 import os
 import time
@@ -14,6 +15,7 @@ import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
+from multiprocessing.process import BaseProcess
 from typing import Any
 
 from zonegraph.errors import ZoneGraphError
@@ -54,7 +56,7 @@ def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -
     recv, send = ctx.Pipe(duplex=False)
     proc = ctx.Process(target=_child, args=(send, fn, args))
     t0 = time.perf_counter()
-    proc.start()
+    _fork(proc)
     send.close()
     try:
         if not recv.poll(timeout):
@@ -75,6 +77,20 @@ def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -
             proc.kill()
             proc.join()
     return Outcome(status, value, reason, time.perf_counter() - t0)
+
+
+def _fork(proc: BaseProcess) -> None:
+    """Start the child with every object inherited from the parent frozen (``gc.freeze``).
+
+    Otherwise the child's first full collection walks the parent's millions of objects (build123d,
+    OCP, scipy), writing to each one's header and so copying its page: measured on ``zonegraph
+    infer`` of a one-extrude part, 0.2 s of collection and 0.5 s per part instead of 0.13 s. The
+    parent unfreezes at once, so its own garbage is still collected."""
+    gc.freeze()
+    try:
+        proc.start()
+    finally:
+        gc.unfreeze()
 
 
 def _run_inline(fn: Callable, args: tuple) -> Outcome:

@@ -8,13 +8,12 @@ agrees with the target after the operation, ties broken by volumetric IoU.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from importlib.metadata import entry_points
 from typing import Protocol
 
 import numpy as np
 
+from zonegraph.plugins import available_guides, guide_factory
 from zonegraph.sequence.proposals import Proposal
 from zonegraph.zones.model import ZoneGraph
 
@@ -72,14 +71,6 @@ class HeuristicRanker:
         return agree + iou / (graph.n_zones + 1)
 
 
-RANKER_PLUGINS = "zonegraph.rankers"  # entry-point group of rankers other packages provide
-
-
-def available_guides() -> list[str]:
-    """The built-in guides and those installed packages register (the network: ``net``)."""
-    return ["heuristic", "random", *sorted(e.name for e in entry_points(group=RANKER_PLUGINS))]
-
-
 def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
     """The ranker a guide name stands for: ``heuristic``, ``random`` (seeded), or a plugin.
 
@@ -94,10 +85,10 @@ def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
         return HeuristicRanker()
     if guide == "random":
         return RandomRanker(seed)
-    for entry in entry_points(group=RANKER_PLUGINS):
-        if entry.name == guide:
-            factory: Callable[..., Ranker] = entry.load()
-            return factory(model=model, seed=seed)
+    factory = guide_factory(guide)
+    if factory is not None:
+        ranker: Ranker = factory(model=model, seed=seed)
+        return ranker
     hint = (
         " (the network guide needs the train extra: pip install 'zonegraph[train]')" if guide == "net" else ""
     )
