@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from build123d import Solid, Unit
+from build123d import Shape, Solid, Unit
 
 from zonegraph.configs import InferConfig
 from zonegraph.data.replay import as_shape
@@ -182,6 +182,16 @@ def _export_fields(export: Export | None) -> dict[str, Any]:
     }
 
 
+def _disagreement(rebuilt: Shape | None, target: Shape, iou: float) -> str:
+    """Why a program exact on zones is not exact as a B-rep, for ``result.json``: the rebuild or
+    the Booleans measuring it failed (a zone-exact program's prisms are the target's zones)."""
+    volume = rebuilt.volume / target.volume if rebuilt is not None and target.volume else 0.0
+    return (
+        f"exact on zones but rebuilt to B-rep IoU {iou:.6g} (volume {volume:.6g} of the target's): "
+        "an OpenCASCADE Boolean of the rebuild or of the IoU failed"
+    )
+
+
 def infer(
     target_path: str | Path,
     out: str | Path,
@@ -216,6 +226,8 @@ def infer(
         iou = brep_iou(states[-1] if states else None, as_shape(rec.solids))
     except RebuildError as exc:
         rebuild_error = str(exc)
+    if not rebuild_error and rec.result.exact and iou < EXACT_IOU:
+        rebuild_error = _disagreement(states[-1] if states else None, as_shape(rec.solids), iou)
     export: Export | None = None
     if states:
         unit = input_unit(path)
