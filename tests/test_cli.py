@@ -167,3 +167,26 @@ def test_help_and_argument_errors_load_no_geometry_kernel(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip().splitlines()[-1] == "[]"
     assert "no such file" in proc.stderr and "unknown guide 'nope'" in proc.stderr
+
+
+@pytest.mark.parametrize("budget", ["0", "-1", "nan"])
+def test_a_budget_that_is_not_positive_is_a_user_error(samples_dir, tmp_path, budget):
+    proc = _cli("infer", str(samples_dir / "Couch.json"), "--out", str(tmp_path / "o"), f"--budget={budget}")
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    message = f"zonegraph: error: --budget {float(budget)}: must be a positive number"
+    assert proc.stderr.strip().splitlines() == [message]
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("command", ["replay", "build", "infer"])
+def test_an_out_that_is_a_file_or_cannot_be_created_is_named_up_front(samples_dir, tmp_path, command):
+    design = str(samples_dir / "Couch.json")
+    existing = tmp_path / "existing"
+    existing.write_text("keep me")
+    proc = _cli(command, design, "--out", str(existing))
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert proc.stderr.strip() == f"zonegraph: error: --out {existing}: exists and is not a folder"
+    assert existing.read_text() == "keep me"
+    below_file = existing / "sub"
+    proc = _cli(command, design, "--out", str(below_file))
+    assert proc.returncode == 2 and f"--out {below_file}: cannot be created" in proc.stderr

@@ -9,6 +9,8 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import math
+import os
 import sys
 from collections.abc import Callable, Sequence
 from functools import partial
@@ -291,10 +293,39 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# Arguments that must be positive where a command has them (0 or less ran a search of no steps).
+POSITIVE = {"budget_s": "--budget", "timeout": "--timeout", "k": "--k", "max_depth": "--max-depth"}
+
+
+def argument_error(args: argparse.Namespace) -> str | None:
+    """What is wrong with the arguments, checked before any geometry is read, or None."""
+    for name, flag in POSITIVE.items():
+        value = getattr(args, name, None)
+        if value is not None and not (math.isfinite(value) and value > 0):
+            return f"{flag} {value}: must be a positive number"
+    if getattr(args, "samples", 0) < 0 or getattr(args, "level", 1) < 1:
+        return "--samples must be 0 or more and --level 1 or more"
+    return out_error(Path(args.out))
+
+
+def out_error(out: Path) -> str | None:
+    """Why ``out`` cannot be the output folder (it is a file, or nothing can be created there)."""
+    if out.exists():
+        return None if out.is_dir() else f"--out {out}: exists and is not a folder"
+    parent = next((p for p in out.absolute().parents if p.exists()), None)
+    if parent is None or not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
+        return f"--out {out}: cannot be created ({parent} is not a writable folder)"
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run a command; ``argv`` None means this process is the command (the console script)."""
     args = build_parser().parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
+    error = argument_error(args)
+    if error:
+        print(f"zonegraph: error: {error}", file=sys.stderr)
+        return EXIT_USER_ERROR
     try:
         return func(args)
     except ZoneGraphError as exc:
