@@ -190,3 +190,9 @@ def test_an_out_that_is_a_file_or_cannot_be_created_is_named_up_front(samples_di
     below_file = existing / "sub"
     proc = _cli(command, design, "--out", str(below_file))
     assert proc.returncode == 2 and f"--out {below_file}: cannot be created" in proc.stderr
+
+
+def test_a_folder_given_as_a_design_is_named_as_a_folder(tmp_path):
+    proc = _cli("replay", str(tmp_path), "--out", str(tmp_path / "o"))
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == f"zonegraph: error: {tmp_path}: is a folder, not a file"

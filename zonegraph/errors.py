@@ -7,6 +7,8 @@ turn it into a one-line message or a manifest row without a traceback, while pro
 
 from __future__ import annotations
 
+from pathlib import Path
+
 
 class ZoneGraphError(Exception):
     """A failure caused by the input, not by a bug: carries the source and a short reason."""
@@ -23,6 +25,15 @@ class InputError(ZoneGraphError):
     """The file cannot be read: missing, corrupt, empty, or of the wrong kind."""
 
     status = "invalid_input"
+
+
+def require_file(path: Path) -> None:
+    """Raise InputError unless ``path`` is a readable file; a folder is named as one (a folder
+    reported as "no such file" sent users looking for a typo)."""
+    if path.is_dir():
+        raise InputError(str(path), "is a folder, not a file")
+    if not path.is_file():
+        raise InputError(str(path), "no such file")
 
 
 class DesignError(ZoneGraphError):

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError
+from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError, require_file
 from zonegraph.geometry.vec import Vec3
 
 
@@ -263,8 +263,7 @@ class Design:
 def load_design(path: str | Path) -> Design:
     """Read a design file; raises :class:`InputError` or :class:`DesignError` with the reason."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError(str(path), "no such file")
+    require_file(path)
     try:
         data = json.loads(path.read_text())
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:

@@ -12,14 +12,13 @@ from pathlib import Path
 from build123d import Shape, Solid, Unit, export_step, import_brep, import_step
 from OCP.BRepTools import BRepTools
 
-from zonegraph.errors import InputError
+from zonegraph.errors import InputError, require_file
 
 
 def read_shape(path: str | Path) -> Shape:
     """A STEP or BREP file as one shape; InputError for missing, empty or corrupt files."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError(str(path), "no such file")
+    require_file(path)
     if path.stat().st_size == 0:
         raise InputError(str(path), "file is empty")
     suffix = path.suffix.lower()
