@@ -29,14 +29,14 @@ MANY = "or a folder of them; several make a batch"
 PER_PART = "; for a batch, the parent of one folder per part and summary.json"
 
 
-def _cmd_replay(args: argparse.Namespace) -> int:
+def replay_and_save(design_path: str, out: Path) -> dict[str, Any]:
+    """Replay a design and write final.step, steps/ and summary.json (run in a killable child)."""
     from zonegraph.data.design import load_design
     from zonegraph.data.replay import replay
     from zonegraph.geometry.shapes import write_step
 
-    design = load_design(args.design)
+    design = load_design(design_path)
     result = replay(design)
-    out = Path(args.out)
     write_step(result.shape, out / "final.step")
     summary = result.summary()
     for i, step in enumerate(result.steps):
@@ -45,8 +45,19 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         write_step(step.tool, out / f"steps/{i:02d}_tool.step")
         summary["steps"][i]["step_file"] = name
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    return {"id": design.id, **summary}
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    from zonegraph.isolation import run_isolated
+
+    out = Path(args.out)
+    outcome = run_isolated(replay_and_save, (args.design, out), timeout=args.timeout)
+    if not outcome.ok:
+        return _fail(args.design, outcome)
+    summary = outcome.value
     print(
-        f"{design.id}: {len(result.steps)} extrudes, {summary['body_count']} bodies, "
+        f"{summary['id']}: {len(summary['steps'])} extrudes, {summary['body_count']} bodies, "
         f"{summary['face_count']} faces, volume {summary['volume']:.6g} cm^3 -> {out}"
     )
     check = summary.get("check")
@@ -240,6 +251,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("replay", help="replay a Fusion 360 Gallery design JSON with build123d")
     p.add_argument("design", help="design JSON file")
     p.add_argument("--out", required=True, help="output folder (final.step, steps/, summary.json)")
+    p.add_argument("--timeout", type=float, default=600.0, help="seconds before the replay is stopped")
     p.set_defaults(func=_cmd_replay)
     p = sub.add_parser("build", help="build the zone graph of STEP/BREP parts or design JSON files")
     p.add_argument("targets", nargs="+", metavar="target", help=f"PART.step, PART.brep, DESIGN.json {MANY}")
