@@ -121,13 +121,18 @@ def _fuse(
     for s in surfaces:
         for sheet in s.sheets:
             builder.AddArgument(sheet)
-    builder.SetFuzzyValue(fuzzy)
-    builder.SetRunParallel(False)
-    builder.SetNonDestructive(True)
-    builder.Perform()
-    if builder.HasErrors():
-        raise ZoneGraphBuildError(BuildStatus.FUSE_FAILED, source, "general fuse reported errors")
-    return builder
+    return _perform(builder, fuzzy, source, "general fuse")
+
+
+def _perform(algo: BOPAlgo_Builder, fuzzy: float, source: str, name: str) -> BOPAlgo_Builder:
+    """Run a general-fuse-family algorithm serially, keeping its arguments intact."""
+    algo.SetFuzzyValue(fuzzy)
+    algo.SetRunParallel(False)
+    algo.SetNonDestructive(True)
+    algo.Perform()
+    if algo.HasErrors():
+        raise ZoneGraphBuildError(BuildStatus.FUSE_FAILED, source, f"{name} reported errors")
+    return algo
 
 
 class _VolumeMaker:
@@ -161,12 +166,7 @@ def _make_volumes(
     maker = BOPAlgo_MakerVolume()
     maker.SetArguments(shape_list([box_solid] + [sheet for s in surfaces for sheet in s.sheets]))
     maker.SetIntersect(True)
-    maker.SetFuzzyValue(fuzzy)
-    maker.SetRunParallel(False)
-    maker.SetNonDestructive(True)
-    maker.Perform()
-    if maker.HasErrors():
-        raise ZoneGraphBuildError(BuildStatus.FUSE_FAILED, source, "volume maker reported errors")
+    _perform(maker, fuzzy, source, "volume maker")
     return _VolumeMaker(maker, box)
 
 
