@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from zonegraph.errors import InputError
+from zonegraph.errors import InputError, file_problem
 from zonegraph.isolation import Outcome
 
 PART_SUFFIXES = (".step", ".stp", ".brep", ".json")
@@ -109,9 +109,9 @@ def name_parts(paths: Sequence[Path]) -> list[Part]:
 
 def unrunnable(path: Path) -> str | None:
     """Why a part cannot start (checked before any kernel import), or None."""
-    if path.is_dir():
+    if path.is_dir():  # a folder stands for its part files: here it had none
         return f"no {', '.join(PART_SUFFIXES)} files in the folder"
-    return None if path.is_file() else "no such file"
+    return file_problem(path)
 
 
 def run_batch(job: BatchJob, parts: Sequence[Part], out: Path) -> list[PartRow]:

@@ -29,27 +29,9 @@ MANY = "or a folder of them; several make a batch"
 PER_PART = "; for a batch, the parent of one folder per part and summary.json"
 
 
-def replay_and_save(design_path: str, out: Path) -> dict[str, Any]:
-    """Replay a design and write final.step, steps/ and summary.json (run in a killable child)."""
-    from zonegraph.data.design import load_design
-    from zonegraph.data.replay import replay
-    from zonegraph.geometry.shapes import write_step
-
-    design = load_design(design_path)
-    result = replay(design)
-    write_step(result.shape, out / "final.step")
-    summary = result.summary()
-    for i, step in enumerate(result.steps):
-        name = f"steps/{i:02d}.step"
-        write_step(step.shape, out / name)
-        write_step(step.tool, out / f"steps/{i:02d}_tool.step")
-        summary["steps"][i]["step_file"] = name
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
-    return {"id": design.id, **summary}
-
-
 def _cmd_replay(args: argparse.Namespace) -> int:
     from zonegraph.isolation import run_isolated
+    from zonegraph.jobs import replay_and_save
 
     out = Path(args.out)
     outcome = run_isolated(replay_and_save, (args.design, out), timeout=args.timeout)

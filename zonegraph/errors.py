@@ -27,13 +27,19 @@ class InputError(ZoneGraphError):
     status = "invalid_input"
 
 
-def require_file(path: Path) -> None:
-    """Raise InputError unless ``path`` is a readable file; a folder is named as one (a folder
-    reported as "no such file" sent users looking for a typo)."""
+def file_problem(path: Path) -> str | None:
+    """Why ``path`` is not a file to read, or None; a folder is named as one (a folder reported
+    as "no such file" sent users looking for a typo)."""
     if path.is_dir():
-        raise InputError(str(path), "is a folder, not a file")
-    if not path.is_file():
-        raise InputError(str(path), "no such file")
+        return "is a folder, not a file"
+    return None if path.is_file() else "no such file"
+
+
+def require_file(path: Path) -> None:
+    """Raise InputError unless ``path`` is a file (:func:`file_problem`)."""
+    problem = file_problem(path)
+    if problem:
+        raise InputError(str(path), problem)
 
 
 class DesignError(ZoneGraphError):

@@ -3,6 +3,7 @@ returns only small plain data (the geometry goes to files)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
@@ -10,8 +11,10 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from zonegraph.configs import BuildConfig
+from zonegraph.data.design import load_design
+from zonegraph.data.replay import replay
 from zonegraph.data.targets import load_target
-from zonegraph.geometry.shapes import read_shape, read_solids
+from zonegraph.geometry.shapes import read_shape, read_solids, write_step
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.ground_truth import ground_truth, search_op
 from zonegraph.sequence.labels import GTOperation, label_design, label_tables
@@ -20,6 +23,21 @@ from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.sampling import export_zone_mesh
 from zonegraph.zones.storage import load_zone_graph, save_zone_graph
+
+
+def replay_and_save(design_path: str, out: Path) -> dict[str, Any]:
+    """Replay a design and write final.step, steps/ and summary.json (run in a killable child)."""
+    design = load_design(design_path)
+    result = replay(design)
+    write_step(result.shape, out / "final.step")
+    summary = result.summary()
+    for i, step in enumerate(result.steps):
+        name = f"steps/{i:02d}.step"
+        write_step(step.shape, out / name)
+        write_step(step.tool, out / f"steps/{i:02d}_tool.step")
+        summary["steps"][i]["step_file"] = name
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    return {"id": design.id, **summary}
 
 
 def build_and_save(

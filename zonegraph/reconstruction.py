@@ -219,19 +219,20 @@ def infer(
     path, out_dir = Path(target_path), Path(out)
     rec = reconstruct(path, config, saved_graph)
     program = build_program(rec.graph, rec.result.steps, rec.generator)
+    target = as_shape(rec.solids)
     states: list = []
     rebuild_error, iou = "", 0.0
     try:
         states = execute(program)
-        iou = brep_iou(states[-1] if states else None, as_shape(rec.solids))
+        iou = brep_iou(states[-1] if states else None, target)
     except RebuildError as exc:
         rebuild_error = str(exc)
     if not rebuild_error and rec.result.exact and iou < EXACT_IOU:
-        rebuild_error = _disagreement(states[-1] if states else None, as_shape(rec.solids), iou)
+        rebuild_error = _disagreement(states[-1] if states else None, target, iou)
     export: Export | None = None
     if states:
         unit = input_unit(path)
-        export = verified_export(program, path.stem, unit, as_shape(rec.solids), iou, EXACT_IOU)
+        export = verified_export(program, path.stem, unit, target, iou, EXACT_IOU)
         write_outputs(export.script, export.design, program, states, out_dir, unit, render)
     exact = bool(iou >= EXACT_IOU)  # the rebuilt B-rep decides, not the zones it was found on
     result = InferResult(

@@ -23,7 +23,7 @@ from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
 from zonegraph.export.snap import REL_TOL, Snapper
 from zonegraph.export.writers import design_text, program_script, written_steps
-from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou
+from zonegraph.sequence.program import ProgramStep, brep_iou
 
 IOU_SLACK = 1e-6  # volume-integration noise between two rebuilds of the same part
 # Written files are measured with faces closer than this fraction of the part's diagonal taken as
@@ -74,19 +74,11 @@ def run_script(text: str) -> Shape:
     return result
 
 
-def _iou(shape: Shape, target: Shape, fuzzy: float) -> float:
-    """B-rep IoU with ``fuzzy``; where the fuzzy Booleans fail, the plain ones may not."""
-    try:
-        return brep_iou(shape, target, fuzzy)
-    except RebuildError:
-        return brep_iou(shape, target)
-
-
 def _measure(build: Callable[[], Shape], target: Shape, fuzzy: float, label: str) -> tuple[float, str]:
     """IoU of ``build()`` against the target; any failure to rebuild is an IoU of 0 and its reason
     (OCP's exceptions share no base class, so none is let through)."""
     try:
-        return _iou(build(), target, fuzzy), ""
+        return brep_iou(build(), target, fuzzy), ""
     except Exception as exc:
         return 0.0, f"{label}: {type(exc).__name__}: {exc}"
 

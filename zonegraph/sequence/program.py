@@ -18,7 +18,7 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.ShapeFix import ShapeFix_Shape
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 
-from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, shape_list, volume_props
+from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, volume_props
 from zonegraph.geometry.shapes import volume_of
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
@@ -129,15 +129,16 @@ def _combine(shape: Shape, tool: Shape, op: Op, index: int) -> Shape:
     """``shape`` fused with or cut by ``tool``, trying in turn: the operands as they are, the tool
     repaired, fuzzy values, and the part so far repaired. The first result the checker accepts
     wins, else the first result as it came: an invalid part often still takes the next Booleans
-    (repairing one in place broke the next union on 4 corpus parts). A step whose Booleans all
-    fail raises RebuildError, which ``result.json`` reports."""
+    (repairing one in place broke the next union of ``130022_505982e4_0000``). A step whose
+    Booleans all fail raises RebuildError, which ``result.json`` reports."""
     diag = float(shape.bounding_box().diagonal)
     first = None
     for x, y, share in _alternatives(shape, tool):
         result = _boolean(x, y, op, share * diag)
         if result is not None and result.is_valid:
             return result
-        first = first or result
+        if first is None:
+            first = result
     if first is None:
         raise RebuildError(f"step {index + 1}: {op.name.lower()} failed (exact, fuzzy, repaired operands)")
     return first
@@ -156,14 +157,13 @@ def _alternatives(shape: Shape, tool: Shape) -> Iterator[tuple[Shape, Shape, flo
 def _boolean(shape: Shape, tool: Shape, op: Op, fuzzy: float) -> Shape | None:
     """One OpenCASCADE fuse or cut, cleaned; None when it fails or comes back empty."""
     algo = BRepAlgoAPI_Fuse() if op is Op.UNION else BRepAlgoAPI_Cut()
-    algo.SetArguments(shape_list([shape.wrapped]))
-    algo.SetTools(shape_list([tool.wrapped]))
-    algo.SetFuzzyValue(fuzzy)
-    algo.SetRunParallel(False)
-    algo.Build()
-    if not algo.IsDone() or algo.Shape().IsNull():
+    try:
+        out = fuzzy_boolean(algo, shape.wrapped, tool.wrapped, fuzzy)
+    except ValueError:
         return None
-    result = Shape.cast(algo.Shape())
+    if out.IsNull():
+        return None
+    result = Shape.cast(out)
     return result.clean() if result.volume > 0 else None
 
 
@@ -189,8 +189,7 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     volume_a, volume_b = a.volume, b.volume
     full = (1 - 1e-9) * min(volume_a, volume_b)
     inter = 0.0
-    tiny = max(fuzzy, 1e-9 * float(b.bounding_box().diagonal))
-    for x, y, value in _common_operands(a, b, fuzzy, tiny):
+    for x, y, value in _common_operands(a, b, fuzzy):
         inter = max(inter, _common_volume(x, y, value))
         if inter >= full:
             break
@@ -199,12 +198,15 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     return inter / union if union > 0 else 1.0
 
 
-def _common_operands(a: Shape, b: Shape, fuzzy: float, tiny: float) -> Iterator[tuple[Shape, Shape, float]]:
+def _common_operands(a: Shape, b: Shape, fuzzy: float) -> Iterator[tuple[Shape, Shape, float]]:
     """Both orders, exact then with a fuzzy value of 1e-9 of the part (a valid program whose exact
-    commons with the target were all empty took it), then a repaired part and a fresh target."""
-    for value in (fuzzy, tiny):
-        yield a, b, value
-        yield b, a, value
+    commons with the target were all empty took it), then a repaired part and a fresh target.
+    Lazy: the usual first common is whole, and nothing after it is computed."""
+    yield a, b, fuzzy
+    yield b, a, fuzzy
+    tiny = max(fuzzy, 1e-9 * float(b.bounding_box().diagonal))
+    yield a, b, tiny
+    yield b, a, tiny
     yield _repaired(a), b, fuzzy
     yield a, Shape.cast(BRepBuilderAPI_Copy(b.wrapped).Shape()), fuzzy
 

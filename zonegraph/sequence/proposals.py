@@ -30,6 +30,7 @@ from zonegraph.zones.model import ZoneGraph
 PARALLEL_TOL = 1e-9
 MIN_DISTANCE = 1e-5  # normalised units: closer parallel planes are not an extrusion
 PRISM_RTOL = 1e-4
+SIDE_WALL_KINDS = ("cylinder", "extrusion")  # curved surfaces a sweep along their axis runs beside
 
 
 class Op(enum.IntEnum):
@@ -207,22 +208,13 @@ class ProposalGenerator:
             for f in self._zone_faces[z]:
                 if g.face_surface[f] == e:
                     continue
-                n = g.face_normal[f]
                 fa, fb = g.face_zones[f]
-                if not np.isfinite(n[0]):  # a curved face: a side wall only if it runs along d
-                    if self._runs_along(f, d / length):
-                        continue
-                    other = fb if fa == z else fa
-                    if other < 0:
-                        return None
-                    stack.append(int(other))
+                if not self._crossed(f, fa == z, d, length):
                     continue
-                outward = n if fa == z else -n  # face normals point from zone a to zone b
-                if float(outward @ d) > PARALLEL_TOL * length:
-                    other = fb if fa == z else fa
-                    if other < 0:
-                        return None
-                    stack.append(int(other))
+                other = fb if fa == z else fa
+                if other < 0:
+                    return None
+                stack.append(int(other))
         if (
             abs(float(g.zone_volume[zones].sum()) - g.face_area[face] * length)
             > PRISM_RTOL * g.face_area[face] * length
@@ -230,12 +222,18 @@ class ProposalGenerator:
             return None
         return zones
 
-    def _runs_along(self, face: int, d: np.ndarray) -> bool:
-        """Whether a curved face lies on a cylinder or extrusion whose axis is parallel to ``d``."""
+    def _crossed(self, face: int, from_first: bool, d: np.ndarray, length: float) -> bool:
+        """Whether a sweep along ``d`` goes on through ``face`` out of the zone it is in (the
+        face's first zone when ``from_first``): a planar face when it faces along d (a cap); a
+        curved face unless it lies on a cylinder or extrusion along d (a side wall)."""
+        n = self.graph.face_normal[face]
+        if np.isfinite(n[0]):
+            outward = n if from_first else -n  # face normals point from zone a to zone b
+            return float(outward @ d) > PARALLEL_TOL * length
         surface = int(self.graph.face_surface[face])
-        if surface < 0 or self.graph.surface_kind[surface] not in ("cylinder", "extrusion"):
-            return False
-        return 1 - abs(float(self.graph.surface_axis[surface, 3:] @ d)) < PARALLEL_TOL
+        if surface < 0 or self.graph.surface_kind[surface] not in SIDE_WALL_KINDS:
+            return True
+        return 1 - abs(float(self.graph.surface_axis[surface, 3:] @ d)) / length >= PARALLEL_TOL
 
     # ------------------------------------------------------------------------ proposals
 
