@@ -21,6 +21,7 @@ from typing import Any
 
 from zonegraph.errors import InputError, file_problem
 from zonegraph.isolation import Outcome
+from zonegraph.outputs import run_staged, write_record
 
 PART_SUFFIXES = (".step", ".stp", ".brep", ".json")
 
@@ -152,14 +153,18 @@ def _stdout_to_stderr() -> Iterator[None]:
 
 def _run_part(job: BatchJob, part: Part, out: Path) -> PartRow:
     reason = unrunnable(part.path)
-    outcome = Outcome(InputError.status, reason=reason) if reason else job.run(part.path, out)
+    if reason:
+        outcome = Outcome(InputError.status, reason=reason)
+    else:
+        outcome = run_staged(lambda scratch: job.run(part.path, scratch), out)
     if outcome.ok:
         values = job.describe(outcome.value)
         status = str(values.pop("status"))
         return PartRow(part.name, str(part.path), status, True, "", round(outcome.seconds, 4), values)
-    out.mkdir(parents=True, exist_ok=True)
     error = {"target": str(part.path), "status": outcome.status, "reason": outcome.reason}
-    (out / "error.json").write_text(json.dumps(error, indent=1))
+    if outcome.detail:
+        error["traceback"] = outcome.detail
+    write_record(out, "error.json", json.dumps(error, indent=1))
     return PartRow(
         part.name, str(part.path), outcome.status, False, outcome.reason, round(outcome.seconds, 4)
     )

@@ -25,16 +25,28 @@ if TYPE_CHECKING:  # imported where used, so that ``zonegraph --help`` loads not
     from zonegraph.isolation import Outcome
 
 EXIT_USER_ERROR = 2
+EXIT_BUG = 1
 MANY = "or a folder of them; several make a batch"
 PER_PART = "; for a batch, the parent of one folder per part and summary.json"
 
 
 def _cmd_replay(args: argparse.Namespace) -> int:
+    from zonegraph.errors import InputError, file_problem
+    from zonegraph.isolation import Outcome
+
+    problem = file_problem(Path(args.design))  # before the kernel is imported
+    if problem:
+        return _fail(args.design, Outcome(InputError.status, reason=problem))
     from zonegraph.isolation import run_isolated
     from zonegraph.jobs import replay_and_save
+    from zonegraph.outputs import run_staged
 
     out = Path(args.out)
-    outcome = run_isolated(replay_and_save, (args.design, out), timeout=args.timeout)
+    tolerance = None if args.no_check else args.tolerance
+    def run(scratch: Path) -> Outcome:
+        return run_isolated(replay_and_save, (args.design, scratch, tolerance), timeout=args.timeout)
+
+    outcome = run_staged(run, out)
     if not outcome.ok:
         return _fail(args.design, outcome)
     summary = outcome.value
@@ -52,6 +64,14 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
 
 def _fail(target: str | Path, outcome: Outcome) -> int:
+    """A failed part's message: one line and exit 2 for the input's fault; a bug's traceback and
+    exit 1, as a bug is ours to fix, not the user's."""
+    from zonegraph.isolation import BUG
+
+    if outcome.status == BUG:
+        message = f"zonegraph: internal error on {target} (a bug: please report it)"
+        print(f"{outcome.detail}{message}", file=sys.stderr)
+        return EXIT_BUG
     print(f"zonegraph: error: {target}: {outcome.status}: {outcome.reason}", file=sys.stderr)
     return EXIT_USER_ERROR
 
@@ -63,7 +83,11 @@ def _batch(job: Callable[[], BatchJob], args: argparse.Namespace) -> int | None:
 
     if not is_batch(args.targets):
         return None
+    from zonegraph.isolation import BUG
+
     rows = run_batch(job(), collect_parts(args.targets), Path(args.out))
+    if any(r.status == BUG for r in rows):
+        return EXIT_BUG
     return EXIT_USER_ERROR if any(not r.ok for r in rows) else 0
 
 
@@ -73,10 +97,14 @@ def _single(job: Callable[[], BatchJob], args: argparse.Namespace) -> Outcome:
     from zonegraph.batch import unrunnable
     from zonegraph.errors import InputError
     from zonegraph.isolation import Outcome
+    from zonegraph.outputs import run_staged
 
     target = Path(args.targets[0])
     reason = unrunnable(target)
-    return Outcome(InputError.status, reason=reason) if reason else job().run(target, Path(args.out))
+    if reason:
+        return Outcome(InputError.status, reason=reason)
+    run = job().run
+    return run_staged(lambda scratch: run(target, scratch), Path(args.out))
 
 
 def _build_job(config: BuildConfig, timeout: float) -> BatchJob:
@@ -234,6 +262,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("design", help="design JSON file")
     p.add_argument("--out", required=True, help="output folder (final.step, steps/, summary.json)")
     p.add_argument("--timeout", type=float, default=600.0, help="seconds before the replay is stopped")
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=1e-6,
+        help="largest relative volume and area error against the file's properties (else exit 2)",
+    )
+    p.add_argument("--no-check", action="store_true", help="keep the result whatever the file's properties")
     p.set_defaults(func=_cmd_replay)
     p = sub.add_parser("build", help="build the zone graph of STEP/BREP parts or design JSON files")
     p.add_argument("targets", nargs="+", metavar="target", help=f"PART.step, PART.brep, DESIGN.json {MANY}")
@@ -288,7 +323,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 # Arguments that must be positive where a command has them (0 or less ran a search of no steps).
-POSITIVE = {"budget_s": "--budget", "timeout": "--timeout", "k": "--k", "max_depth": "--max-depth"}
+POSITIVE = {
+    "budget_s": "--budget",
+    "timeout": "--timeout",
+    "k": "--k",
+    "max_depth": "--max-depth",
+    "tolerance": "--tolerance",
+}
 
 
 def argument_error(args: argparse.Namespace) -> str | None:

@@ -20,6 +20,10 @@ class ZoneGraphError(Exception):
         self.source = source
         self.reason = reason
 
+    def explain(self) -> str:
+        """The reason as a message that already names the source shows it (no source)."""
+        return self.reason
+
 
 class InputError(ZoneGraphError):
     """The file cannot be read: missing, corrupt, empty, or of the wrong kind."""
@@ -53,6 +57,10 @@ class DesignError(ZoneGraphError):
         self.design = design
         self.entity = entity
 
+    def explain(self) -> str:
+        """The reason with the entity it is about: a design has many, all alike but for the uuid."""
+        return f"[{self.entity}] {self.reason}" if self.entity else self.reason
+
 
 class UnsupportedFeatureError(DesignError):
     """The design uses something outside the sketch + extrude subset we replay exactly."""
@@ -64,3 +72,9 @@ class ReplayError(DesignError):
     """OpenCASCADE could not build a step (a Boolean failed or produced no solid)."""
 
     status = "replay_failed"
+
+
+class ReplayMismatchError(DesignError):
+    """The replay ran, but its result disagrees with the design file's own ``properties``."""
+
+    status = "replay_mismatch"

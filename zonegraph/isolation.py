@@ -10,9 +10,13 @@ from __future__ import annotations
 import gc
 import multiprocessing as mp
 import os
+import sys
+import tempfile
 import time
 import traceback
-from collections.abc import Callable
+import warnings
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
 from multiprocessing.process import BaseProcess
@@ -20,32 +24,81 @@ from typing import Any
 
 from zonegraph.errors import ZoneGraphError
 
+BUG = "bug"  # an exception of our own code: the caller shows its traceback
+KERNEL_ERROR = "kernel_error"  # OpenCASCADE raised on this input's geometry
+
 
 @dataclass(frozen=True)
 class Outcome:
-    status: str  # "ok", "timeout", "crash", "error" or a ZoneGraphError status
+    status: str  # "ok", "timeout", "crash", BUG, KERNEL_ERROR or a ZoneGraphError status
     value: Any = None
-    reason: str = ""
+    reason: str = ""  # one line
     seconds: float = 0.0
+    detail: str = ""  # a bug's traceback
 
     @property
     def ok(self) -> bool:
         return self.status == "ok"
 
 
+def classify(exc: BaseException) -> tuple[str, str, str]:
+    """``(status, one-line reason, traceback)`` of an exception raised by a job.
+
+    OpenCASCADE's exceptions (``Standard_Failure`` and its kin, raised through OCP) are failures of
+    the kernel on this input's geometry, e.g. ``Standard_DomainError`` from a Boolean on a part at
+    1e12 cm: a status like any unbuildable input. Every other exception is a bug of ours and keeps
+    its traceback."""
+    if isinstance(exc, ZoneGraphError):
+        return exc.status, exc.explain(), ""
+    last = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
+    where = f" ({os.path.basename(last.filename)}:{last.lineno} {last.name})" if last else ""
+    name = type(exc).__name__
+    message = " ".join(str(exc).split()) or "no message"
+    if _is_kernel(exc):
+        return KERNEL_ERROR, f"OpenCASCADE {name}: {message}{where}", ""
+    return BUG, f"{name}: {message}{where}", "".join(traceback.format_exception(exc))
+
+
+def _is_kernel(exc: BaseException) -> bool:
+    return any(
+        c.__module__.startswith("OCP") and c.__name__.startswith("Standard_") for c in type(exc).__mro__
+    )
+
+
 def _child(conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
+    """Run the job with its console output captured: OpenCASCADE prints messages such as
+    ``**** ERR StepFile`` from C++ straight to file descriptor 1, and numpy's warnings go to 2;
+    neither belongs on the user's terminal."""
     try:
-        conn.send(("ok", fn(*args), ""))
-    except ZoneGraphError as exc:
-        conn.send((exc.status, None, exc.reason))
-    except Exception as exc:  # a bug or an unexpected OCP failure: keep the reason, not the process
-        last = traceback.extract_tb(exc.__traceback__)[-1]
-        conn.send(
-            ("error", None, f"{type(exc).__name__}: {exc} ({os.path.basename(last.filename)}:{last.lineno})")
-        )
+        with _captured_console():
+            conn.send(("ok", fn(*args), "", ""))
+    except BaseException as exc:  # noqa: BLE001 - every outcome, bugs included, goes to the parent
+        status, reason, detail = classify(exc)
+        conn.send((status, None, reason, detail))
     finally:
         conn.close()
         os._exit(0)
+
+
+@contextmanager
+def _captured_console() -> Iterator[None]:
+    """File descriptors 1 and 2 (and Python's warnings) go to a scratch file for the duration."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    with tempfile.TemporaryFile() as sink, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        os.dup2(sink.fileno(), 1)
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in saved:
+                os.close(fd)
 
 
 def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -> Outcome:
@@ -64,7 +117,7 @@ def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -
             return Outcome(
                 "timeout", reason=f"no result after {timeout:g} s", seconds=time.perf_counter() - t0
             )
-        status, value, reason = recv.recv()
+        status, value, reason, detail = recv.recv()
     except EOFError:
         proc.join()
         return Outcome(
@@ -76,7 +129,7 @@ def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -
         if proc.is_alive():
             proc.kill()
             proc.join()
-    return Outcome(status, value, reason, time.perf_counter() - t0)
+    return Outcome(status, value, reason, time.perf_counter() - t0, detail)
 
 
 def _fork(proc: BaseProcess) -> None:
@@ -94,9 +147,13 @@ def _fork(proc: BaseProcess) -> None:
 
 
 def _run_inline(fn: Callable, args: tuple) -> Outcome:
-    """No timeout asked for: run in-process (debuggable), with the same error capture."""
+    """No timeout asked for: run in-process, with the same outcomes, except that a bug raises here
+    (debuggable where it happened) and the console is not captured."""
     t0 = time.perf_counter()
     try:
         return Outcome("ok", fn(*args), "", time.perf_counter() - t0)
-    except ZoneGraphError as exc:
-        return Outcome(exc.status, None, exc.reason, time.perf_counter() - t0)
+    except Exception as exc:
+        status, reason, _ = classify(exc)
+        if status == BUG:
+            raise
+        return Outcome(status, None, reason, time.perf_counter() - t0)

@@ -14,6 +14,7 @@ from zonegraph.configs import BuildConfig
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.data.targets import load_target
+from zonegraph.errors import ReplayMismatchError
 from zonegraph.geometry.shapes import read_shape, read_solids, write_step
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.ground_truth import ground_truth, search_op
@@ -25,10 +26,18 @@ from zonegraph.zones.sampling import export_zone_mesh
 from zonegraph.zones.storage import load_zone_graph, save_zone_graph
 
 
-def replay_and_save(design_path: str, out: Path) -> dict[str, Any]:
-    """Replay a design and write final.step, steps/ and summary.json (run in a killable child)."""
+def replay_and_save(design_path: str, out: Path, tolerance: float | None = None) -> dict[str, Any]:
+    """Replay a design and write final.step, steps/ and summary.json (run in a killable child).
+
+    Raises:
+        ReplayMismatchError: ``tolerance`` given and the result disagrees with the file's own
+            properties beyond it (nothing is written).
+    """
     design = load_design(design_path)
     result = replay(design)
+    problem = None if tolerance is None else result.disagreement(tolerance)
+    if problem:
+        raise ReplayMismatchError(design_path, None, problem)
     write_step(result.shape, out / "final.step")
     summary = result.summary()
     for i, step in enumerate(result.steps):

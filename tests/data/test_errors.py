@@ -93,7 +93,7 @@ def test_unknown_curve_type(tmp_path):
 def test_empty_profile(tmp_path):
     data = square_design()
     data["entities"]["s0"]["profiles"]["p"]["loops"] = []
-    with pytest.raises(DesignError, match="no outer loop"):
+    with pytest.raises(DesignError, match=r"\[s0\]: profiles.p.loops: list should have at least 1 item"):
         replay_file(fj.write(tmp_path, data))
 
 

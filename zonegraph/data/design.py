@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from zonegraph.data.schema import validate_design
 from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError, require_file
 from zonegraph.geometry.vec import Vec3
 
@@ -272,7 +273,8 @@ def load_design(path: str | Path) -> Design:
 
 
 def parse_design(data: Any, design_id: str, source: str = "") -> Design:
-    """A design from parsed JSON; every reference is checked before any geometry is built.
+    """A design from parsed JSON; the schema (:mod:`zonegraph.data.schema`) and every reference
+    are checked before any geometry is built.
 
     Raises:
         InputError: not a design at all; DesignError or UnsupportedFeatureError: naming the entity.
@@ -280,6 +282,7 @@ def parse_design(data: Any, design_id: str, source: str = "") -> Design:
     name = source or design_id
     if not isinstance(data, dict) or "timeline" not in data or "entities" not in data:
         raise InputError(name, "not a Fusion 360 Gallery design (no timeline/entities)")
+    validate_design(data, name)
     entities = data["entities"]
     timeline: list[Entity] = []
     for item in data["timeline"]:
@@ -317,7 +320,7 @@ def _parse_sketch(e: dict, uuid: str, design: str) -> Sketch:
             Loop(bool(lp["is_outer"]), tuple(_parse_curve(c, pid, design) for c in lp["profile_curves"]))
             for lp in p["loops"]
         )
-        area = p.get("properties", {}).get("area")
+        area = (p.get("properties") or {}).get("area")
         profiles[pid] = Profile(pid, loops, None if area is None else float(area))
     return Sketch(uuid, e.get("name", ""), frame, profiles)
 
@@ -365,7 +368,7 @@ def _parse_curve(c: dict, profile: str, design: str) -> Curve:
 def _parse_extent(d: dict) -> Extent:
     if d.get("type", "DistanceExtentDefinition") != "DistanceExtentDefinition":
         raise ValueError(f"extent {d.get('type')!r}")
-    taper = d.get("taper_angle", {}).get("value", 0.0)
+    taper = (d.get("taper_angle") or {}).get("value", 0.0)
     return Extent(float(d["distance"]["value"]), float(taper))
 
 
@@ -379,10 +382,10 @@ def _parse_extrude(e: dict, uuid: str, design: str) -> Extrude:
     except ValueError:
         raise UnsupportedFeatureError(design, uuid, f"unsupported extent type {e['extent_type']!r}") from None
     for key in ("extent_one", "extent_two"):
-        kind = e.get(key, {}).get("type", "DistanceExtentDefinition")
+        kind = (e.get(key) or {}).get("type", "DistanceExtentDefinition")
         if kind != "DistanceExtentDefinition":
             raise UnsupportedFeatureError(design, uuid, f"unsupported {key} {kind!r} (only distances)")
-    start = e.get("start_extent", {"type": "ProfilePlaneStartDefinition"})
+    start = e.get("start_extent") or {"type": "ProfilePlaneStartDefinition"}
     if start["type"] == "OffsetStartDefinition":
         offset = float(start["offset"]["value"])
     elif start["type"] == "ProfilePlaneStartDefinition":
@@ -391,7 +394,7 @@ def _parse_extrude(e: dict, uuid: str, design: str) -> Extrude:
         raise UnsupportedFeatureError(design, uuid, f"unsupported start extent {start['type']!r}")
     two = _parse_extent(e["extent_two"]) if extent_type is ExtentType.TWO_SIDES else None
     labels = None
-    if "bodies" in e and "faces" in e:
+    if e.get("bodies") is not None and e.get("faces") is not None:
         labels = StepLabels(len(e["bodies"]), len(e["faces"]))
     return Extrude(
         id=uuid,
@@ -408,7 +411,7 @@ def _parse_extrude(e: dict, uuid: str, design: str) -> Extrude:
 
 
 def _parse_properties(p: dict | None) -> DesignProperties | None:
-    if not p or "volume" not in p:
+    if not p or p.get("volume") is None:
         return None
     bbox = p.get("bounding_box")
     return DesignProperties(

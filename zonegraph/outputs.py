@@ -1,0 +1,77 @@
+"""Atomic command outputs: a run writes into a scratch folder beside ``--out`` and moves its files
+into place only when it succeeded.
+
+Before this, an ``infer`` stopped at its timeout left ``sequence.py``, ``sequence.json`` and
+``steps/00.step`` without a ``result.json``, and an earlier run's ``result.json`` in the same folder
+stayed as if it were current. Now each completed run lists what it wrote in :data:`LISTING`; the
+next run into the same folder first removes exactly those entries (never a file it did not write),
+so after a failure the folder holds nothing that looks current, and after a success only the new
+run's files.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+from zonegraph.isolation import Outcome
+
+LISTING = ".zonegraph-outputs.json"
+
+
+def run_staged(run: Callable[[Path], Outcome], out: Path) -> Outcome:
+    """``run(scratch)`` and, if it succeeded, its files moved into ``out``; if it failed, the
+    scratch folder and the outputs of the previous run into ``out`` are removed."""
+    out = Path(os.path.abspath(out))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    scratch = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+    try:
+        outcome = run(scratch)
+        _remove_listed(out)
+        if outcome.ok:
+            _move_into(scratch, out)
+        return outcome
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _remove_listed(out: Path) -> None:
+    """Remove what the last completed run wrote into ``out``, as its listing names it."""
+    listing = out / LISTING
+    try:
+        names = json.loads(listing.read_text())["names"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return
+    for name in names:
+        if isinstance(name, str) and name and Path(name).name == name:  # an entry of out, no path
+            _remove(out / name)
+    listing.unlink(missing_ok=True)
+
+
+def _move_into(scratch: Path, out: Path) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    names = sorted(p.name for p in scratch.iterdir())
+    for name in names:
+        _remove(out / name)
+        os.replace(scratch / name, out / name)
+    (out / LISTING).write_text(json.dumps({"names": names}))
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    elif path.exists() or path.is_symlink():
+        path.unlink()
+
+
+def write_record(out: Path, name: str, text: str) -> None:
+    """Write one file into ``out`` as the whole output of a run (a failed part's ``error.json``),
+    listed so that the next run replaces it like any other output."""
+    _remove_listed(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / name).write_text(text)
+    (out / LISTING).write_text(json.dumps({"names": [name]}))
