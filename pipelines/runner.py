@@ -85,6 +85,8 @@ def _execute(fn: Callable, job: Job, timeout: float | None) -> dict:
     }
     if outcome.ok and outcome.value:
         record.update(outcome.value)
+    if outcome.detail:  # a bug: its traceback, for whoever fixes it
+        record["traceback"] = outcome.detail
     return record
 
 
