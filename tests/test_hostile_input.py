@@ -179,5 +179,6 @@ def test_a_corrupt_step_prints_one_line_and_no_kernel_messages(samples_dir, tmp_
     truncated.write_bytes((samples_dir / "Couch.step").read_bytes()[:3000])
     for command in ("build", "infer"):
         message = _one_line_error(_cli(command, str(truncated), "--out", str(tmp_path / command)))
-        assert message.endswith("invalid_input: file holds no shape (corrupt or empty)")
+        assert "invalid_input: file holds no shape (corrupt or empty): ERR StepFile" in message
+        assert "Incorrect syntax" in message  # the kernel's own reason, moved into the one line
         assert not (tmp_path / command).exists()

@@ -10,18 +10,15 @@ from __future__ import annotations
 import gc
 import multiprocessing as mp
 import os
-import sys
-import tempfile
 import time
 import traceback
-import warnings
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
 from multiprocessing.process import BaseProcess
 from typing import Any
 
+from zonegraph.console import captured
 from zonegraph.errors import ZoneGraphError
 
 BUG = "bug"  # an exception of our own code: the caller shows its traceback
@@ -70,7 +67,7 @@ def _child(conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...]) -> N
     ``**** ERR StepFile`` from C++ straight to file descriptor 1, and numpy's warnings go to 2;
     neither belongs on the user's terminal."""
     try:
-        with _captured_console():
+        with captured():
             conn.send(("ok", fn(*args), "", ""))
     except BaseException as exc:  # noqa: BLE001 - every outcome, bugs included, goes to the parent
         status, reason, detail = classify(exc)
@@ -78,27 +75,6 @@ def _child(conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...]) -> N
     finally:
         conn.close()
         os._exit(0)
-
-
-@contextmanager
-def _captured_console() -> Iterator[None]:
-    """File descriptors 1 and 2 (and Python's warnings) go to a scratch file for the duration."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    saved = [os.dup(1), os.dup(2)]
-    with tempfile.TemporaryFile() as sink, warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        os.dup2(sink.fileno(), 1)
-        os.dup2(sink.fileno(), 2)
-        try:
-            yield
-        finally:
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            for fd in saved:
-                os.close(fd)
 
 
 def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -> Outcome:

@@ -12,6 +12,7 @@ from pathlib import Path
 from build123d import Shape, Solid, Unit, export_step, import_brep, import_step
 from OCP.BRepTools import BRepTools
 
+from zonegraph.console import captured
 from zonegraph.errors import InputError, require_file
 
 
@@ -22,19 +23,19 @@ def read_shape(path: str | Path) -> Shape:
     if path.stat().st_size == 0:
         raise InputError(str(path), "file is empty")
     suffix = path.suffix.lower()
-    try:
-        if suffix in (".step", ".stp"):
-            shape = import_step(str(path))
-        elif suffix == ".brep":
-            shape = import_brep(str(path))
+    if suffix not in (".step", ".stp", ".brep"):
+        raise InputError(str(path), f"unknown shape format {suffix!r} (expected .step/.stp/.brep)")
+    with captured() as console:  # the STEP reader prints its syntax errors from C++
+        try:
+            shape = import_brep(str(path)) if suffix == ".brep" else import_step(str(path))
+        except Exception as exc:  # OCP raises bare RuntimeError/ValueError for corrupt files
+            shape, error = None, " ".join(str(exc).split())
         else:
-            raise InputError(str(path), f"unknown shape format {suffix!r} (expected .step/.stp/.brep)")
-    except InputError:
-        raise
-    except Exception as exc:  # OCP raises bare RuntimeError/ValueError for corrupt files
-        raise InputError(str(path), f"cannot read {suffix[1:].upper()} ({exc})") from None
+            error = ""
     if shape is None or shape.is_null:
-        raise InputError(str(path), "file holds no shape (corrupt or empty)")
+        said = console.kernel_errors()
+        why = f": {said[0]}" if said else f" ({error})" if error else ""
+        raise InputError(str(path), f"file holds no shape (corrupt or empty){why}")
     return shape
 
 
