@@ -14,7 +14,16 @@ PACKAGE = Path(zonegraph.__file__).parent
 # Each layer may import only layers of a lower rank (and itself); data and zones are siblings.
 # errors, console (capturing native output) and plugins (entry-point groups) import nothing heavy
 # and serve every layer.
-RANK = {"errors": 0, "console": 0, "plugins": 0, "geometry": 1, "data": 2, "zones": 2, "sequence": 3, "export": 4}
+RANK = {
+    "errors": 0,
+    "console": 0,
+    "plugins": 0,
+    "geometry": 1,
+    "data": 2,
+    "zones": 2,
+    "sequence": 3,
+    "export": 4,
+}
 TOP = 5  # reconstruction, cli, batch, jobs, isolation, outputs, configs and the package root
 
 
