@@ -93,6 +93,7 @@ VALUES: dict[str, Any] = {
 }
 TYPE_KEYS = ("type", "operation", "extent_type")
 ODD_TYPES = ("FilletFeature", "RevolveFeature", "NewComponentFeatureOperation", "Bogus", "")
+EXTRUDE_KEYS = {"profiles", "operation", "start_extent", "extent_type", "extent_one", "extent_two", "type"}
 IGNORED_KEYS = {"curves", "points", "constraints", "dimensions"}  # sketch data replay does not read
 STEP_TOKENS = ("1.E+300", "-1.E+300", "0.", "1.E-300", "NAN", "INF", "1.2.3", "'x'", "$", "*")
 UNITS = (
@@ -161,19 +162,30 @@ def _walk(node: Any, path: tuple) -> Iterator[tuple]:
 
 
 @cache
-def value_paths(name: str) -> tuple[tuple[tuple, ...], tuple[tuple, ...]]:
-    """Every path in a design (the root included), and those replay reads (timeline, and entities
-    without the sketch data it ignores): most draws go there, where a mutation matters."""
-    paths = tuple(_walk(design(name), ()))[1:] + ((),)  # the root last: Hypothesis favours the first
+def value_paths(name: str) -> dict[str, tuple[tuple, ...]]:
+    """A design's paths by region: ``extrude`` (the ExtrudeFeature fields replay reads: extents,
+    operation, profile references), ``transform`` (sketch frames), ``profile`` (profile loops and curves),
+    ``read`` (all that replay reads: the timeline, entities without the sketch data it ignores) and
+    ``any`` (every path, the root last: Hypothesis favours a pool's first item). Regions are drawn
+    first, so that the few fields where a bad number hurts most are not drowned by curve points."""
+    doc = design(name)
+    paths = tuple(_walk(doc, ()))[1:] + ((),)
     read = tuple(
-        p for p in paths if p and p[0] in ("timeline", "entities") and not IGNORED_KEYS.intersection(p)
+        p for p in paths if p[:1] in (("timeline",), ("entities",)) and not IGNORED_KEYS.intersection(p)
     )
-    return paths, read
+    extrudes = {k for k, e in doc.get("entities", {}).items() if e.get("type") == "ExtrudeFeature"}
+    return {
+        "extrude": tuple(p for p in read if len(p) > 2 and p[1] in extrudes and p[2] in EXTRUDE_KEYS),
+        "transform": tuple(p for p in read if "transform" in p),
+        "profile": tuple(p for p in read if "profiles" in p and p[1] not in extrudes),
+        "read": read,
+        "any": paths,
+    }
 
 
 @cache
 def type_paths(name: str) -> tuple[tuple, ...]:
-    return tuple(p for p in value_paths(name)[0] if p and p[-1] in TYPE_KEYS)
+    return tuple(p for p in value_paths(name)["any"] if p and p[-1] in TYPE_KEYS)
 
 
 @cache
@@ -198,8 +210,8 @@ def json_mutations(draw: st.DrawFn) -> dict[str, Any]:
         st.sampled_from(("replace", "replace", "replace", "delete", "timeline", "type", "truncate", "utf8"))
     )
     if op in ("replace", "delete"):
-        everything, read = value_paths(name)
-        pool = read if draw(st.integers(0, 4)) else everything
+        regions = value_paths(name)
+        pool = regions[draw(st.sampled_from(("extrude", "extrude", "transform", "profile", "read", "any")))]
         if op == "delete":
             pool = tuple(p for p in pool if p) or pool
         path = draw(st.sampled_from(pool))
