@@ -93,6 +93,7 @@ VALUES: dict[str, Any] = {
 }
 TYPE_KEYS = ("type", "operation", "extent_type")
 ODD_TYPES = ("FilletFeature", "RevolveFeature", "NewComponentFeatureOperation", "Bogus", "")
+EXTENT_KEYS = {"start_extent", "extent_one", "extent_two"}
 EXTRUDE_KEYS = {"profiles", "operation", "start_extent", "extent_type", "extent_one", "extent_two", "type"}
 IGNORED_KEYS = {"curves", "points", "constraints", "dimensions"}  # sketch data replay does not read
 STEP_TOKENS = ("1.E+300", "-1.E+300", "0.", "1.E-300", "NAN", "INF", "1.2.3", "'x'", "$", "*")
@@ -163,8 +164,9 @@ def _walk(node: Any, path: tuple) -> Iterator[tuple]:
 
 @cache
 def value_paths(name: str) -> dict[str, tuple[tuple, ...]]:
-    """A design's paths by region: ``extrude`` (the ExtrudeFeature fields replay reads: extents,
-    operation, profile references), ``transform`` (sketch frames), ``profile`` (profile loops and curves),
+    """A design's paths by region: ``extent`` (the extrudes' distances, tapers and offsets),
+    ``extrude`` (the ExtrudeFeature fields replay reads: extents, operation, profile references),
+    ``transform`` (sketch frames), ``profile`` (profile loops and curves),
     ``read`` (all that replay reads: the timeline, entities without the sketch data it ignores) and
     ``any`` (every path, the root last: Hypothesis favours a pool's first item). Regions are drawn
     first, so that the few fields where a bad number hurts most are not drowned by curve points."""
@@ -174,8 +176,10 @@ def value_paths(name: str) -> dict[str, tuple[tuple, ...]]:
         p for p in paths if p[:1] in (("timeline",), ("entities",)) and not IGNORED_KEYS.intersection(p)
     )
     extrudes = {k for k, e in doc.get("entities", {}).items() if e.get("type") == "ExtrudeFeature"}
+    extrude = tuple(p for p in read if len(p) > 2 and p[1] in extrudes and p[2] in EXTRUDE_KEYS)
     return {
-        "extrude": tuple(p for p in read if len(p) > 2 and p[1] in extrudes and p[2] in EXTRUDE_KEYS),
+        "extent": tuple(p for p in extrude if p[2] in EXTENT_KEYS and p[-1] == "value"),
+        "extrude": extrude,
         "transform": tuple(p for p in read if "transform" in p),
         "profile": tuple(p for p in read if "profiles" in p and p[1] not in extrudes),
         "read": read,
@@ -211,7 +215,7 @@ def json_mutations(draw: st.DrawFn) -> dict[str, Any]:
     )
     if op in ("replace", "delete"):
         regions = value_paths(name)
-        pool = regions[draw(st.sampled_from(("extrude", "extrude", "transform", "profile", "read", "any")))]
+        pool = regions[draw(st.sampled_from(("extent", "extrude", "transform", "profile", "read", "any")))]
         if op == "delete":
             pool = tuple(p for p in pool if p) or pool
         path = draw(st.sampled_from(pool))
