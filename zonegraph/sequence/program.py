@@ -21,8 +21,7 @@ from OCP.ShapeFix import ShapeFix_Shape, ShapeFix_ShapeTolerance
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SHAPE, TopAbs_SOLID
 
 from zonegraph.geometry.cells import select_cells
-from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, volume_props
-from zonegraph.geometry.shapes import volume_of
+from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, precise_volume
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
@@ -238,7 +237,7 @@ def _repaired(shape: Shape) -> Shape:
 
 
 def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
-    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans.
+    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans, volumes by :func:`precise_volume`.
 
     A Boolean common of two coincident solids can come back empty although both are valid, and
     which call fails depends on the argument order (on the corpus: common(program, target) empty,
@@ -250,7 +249,7 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     back with almost no volume."""
     if a is None:
         return 0.0
-    volume_a, volume_b = a.volume, b.volume
+    volume_a, volume_b = _volume(a), _volume(b)
     full = (1 - 1e-9) * min(volume_a, volume_b)
     inter = 0.0
     for x, y, value in _common_operands(a, b, fuzzy):
@@ -296,7 +295,14 @@ def _tightened(shape: Shape) -> Shape:
 def _common_volume(a: Shape, b: Shape, fuzzy: float) -> float:
     try:
         if fuzzy <= 0.0:
-            return volume_of(a.intersect(b))
-        return volume_props(fuzzy_boolean(BRepAlgoAPI_Common(), a.wrapped, b.wrapped, fuzzy))[0]
+            return _volume(a.intersect(b))
+        return precise_volume(fuzzy_boolean(BRepAlgoAPI_Common(), a.wrapped, b.wrapped, fuzzy))
     except ValueError:  # a null or failed Boolean result
         return 0.0
+
+
+def _volume(shape: Shape | list[Shape] | None) -> float:
+    """The precise volume of a shape or of a Boolean result (a list of shapes from build123d's
+    intersect, or None)."""
+    shapes = [] if shape is None else [shape] if isinstance(shape, Shape) else shape
+    return sum(precise_volume(s.wrapped) for s in shapes)
