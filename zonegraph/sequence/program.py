@@ -236,6 +236,12 @@ def _repaired(shape: Shape) -> Shape:
     return Shape.cast(fix.Shape())
 
 
+# Relative volume difference below which two solids whose commons all fell short are measured
+# again with the part's tolerances limited: the IoU's own exactness threshold. Partial programs
+# (most differ from the target by far more) skip those two commons.
+ALIKE_RTOL = 1e-4
+
+
 def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     """vol(a and b) / vol(a or b) with OpenCASCADE Booleans, volumes by :func:`precise_volume`.
 
@@ -252,7 +258,8 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     volume_a, volume_b = _volume(a), _volume(b)
     full = (1 - 1e-9) * min(volume_a, volume_b)
     inter = 0.0
-    for x, y, value in _common_operands(a, b, fuzzy):
+    alike = abs(volume_a - volume_b) <= ALIKE_RTOL * max(volume_a, volume_b)
+    for x, y, value in _common_operands(a, b, fuzzy, alike):
         inter = max(inter, _common_volume(x, y, value))
         if inter >= full:
             break
@@ -261,11 +268,12 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     return inter / union if union > 0 else 1.0
 
 
-def _common_operands(a: Shape, b: Shape, fuzzy: float) -> Iterator[tuple[Shape, Shape, float]]:
+def _common_operands(a: Shape, b: Shape, fuzzy: float, alike: bool) -> Iterator[tuple[Shape, Shape, float]]:
     """Both orders, exact then with a fuzzy value of 1e-9 of the part (a valid program whose exact
-    commons with the target were all empty took it), then a repaired part, a fresh target, and
-    the part with its tolerances limited (:func:`_tightened`). Lazy: the usual first common is
-    whole, and nothing after it is computed."""
+    commons with the target were all empty took it), then a repaired part and a fresh target,
+    and, for solids of the same volume (``alike``), the part with its tolerances limited
+    (:func:`_tightened`). Lazy: the usual first common is whole, and nothing after it is
+    computed."""
     yield a, b, fuzzy
     yield b, a, fuzzy
     tiny = max(fuzzy, 1e-9 * float(b.bounding_box().diagonal))
@@ -273,8 +281,8 @@ def _common_operands(a: Shape, b: Shape, fuzzy: float) -> Iterator[tuple[Shape, 
     yield b, a, tiny
     yield _repaired(a), b, fuzzy
     yield a, Shape.cast(BRepBuilderAPI_Copy(b.wrapped).Shape()), fuzzy
-    tight = _tightened(a)
-    if tight.is_valid:
+    tight = _tightened(a) if alike else None
+    if tight is not None and tight.is_valid:
         yield tight, b, fuzzy
         yield b, tight, fuzzy
 
