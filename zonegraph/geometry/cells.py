@@ -1,33 +1,92 @@
-"""Turn a set of zones back into one clean solid (for checks, canvases and rendering).
+"""Turn a set of zones, or the cells of overlapping solids, back into one clean solid.
 
-``BOPAlgo_CellsBuilder`` re-runs the general fuse on the zones, keeps the selected cells and
+``BOPAlgo_CellsBuilder`` re-runs the general fuse on its arguments, keeps the selected cells and
 removes the boundaries between them; unifying same-domain faces then merges the pieces of each
 face, so the result has the target's faces, not the zones'.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from OCP.BOPAlgo import BOPAlgo_CellsBuilder
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
+from OCP.TopAbs import TopAbs_SOLID
 from OCP.TopoDS import TopoDS_Shape
 
-from zonegraph.geometry.occ import shape_list
+from zonegraph.geometry.occ import make_compound, shape_index, shape_list, shapes_of, sub_shapes
 
 
 def fuse_zones(zones: Sequence[TopoDS_Shape], selected: Sequence[int]) -> TopoDS_Shape:
     """The union of ``zones[i]`` for ``i`` in ``selected``, internal boundaries removed."""
-    builder = BOPAlgo_CellsBuilder()
-    for z in zones:
-        builder.AddArgument(z)
-    builder.SetRunParallel(False)
-    builder.Perform()
-    if builder.HasErrors():
-        raise RuntimeError("cells builder failed")
+    builder = _cells(zones, 0.0)
     for i in selected:
         builder.AddToResult(shape_list([zones[i]]), shape_list([]), 1, False)
     builder.RemoveInternalBoundaries()
-    unify = ShapeUpgrade_UnifySameDomain(builder.Shape(), True, True, True)
+    return _unified(builder.Shape())
+
+
+def select_cells(
+    arguments: Sequence[TopoDS_Shape], keep: Callable[[frozenset[int]], bool], fuzzy: float = 0.0
+) -> TopoDS_Shape:
+    """The cells of the general fuse of ``arguments`` whose owners (the indices of the arguments
+    that contain the cell) ``keep`` accepts, as one solid with internal boundaries removed.
+
+    One fuse of every operand at once evaluates any Boolean expression of them: it does not
+    depend on a chain of Booleans, each of which may fail on the result of the one before.
+    Unifying same-domain faces broke every valid result of ``41125_711db4bf_0002``'s tools (and,
+    working in place, the raw result too), so a copy is unified and kept only when the checker
+    accepts it or rejects the raw result as well.
+
+    Raises:
+        RuntimeError: the general fuse reported errors.
+    """
+    builder = _cells(arguments, fuzzy)
+    for owners in {o for o in _cell_owners(builder, arguments) if keep(o)}:
+        take = [arguments[i] for i in sorted(owners)]
+        avoid = [a for i, a in enumerate(arguments) if i not in owners]
+        builder.AddToResult(shape_list(take), shape_list(avoid), 1, False)
+    builder.RemoveInternalBoundaries()
+    raw = builder.Shape()
+    unified = _unified(BRepBuilderAPI_Copy(raw).Shape())
+    return unified if _valid(unified) or not _valid(raw) else raw
+
+
+def _cells(arguments: Sequence[TopoDS_Shape], fuzzy: float) -> BOPAlgo_CellsBuilder:
+    builder = BOPAlgo_CellsBuilder()
+    for a in arguments:
+        builder.AddArgument(a)
+    builder.SetFuzzyValue(fuzzy)
+    builder.SetRunParallel(False)
+    builder.SetNonDestructive(True)
+    builder.Perform()
+    if builder.HasErrors():
+        raise RuntimeError("cells builder failed")
+    return builder
+
+
+def _cell_owners(builder: BOPAlgo_CellsBuilder, arguments: Sequence[TopoDS_Shape]) -> list[frozenset[int]]:
+    """For every cell, the arguments containing it: the cells are the images of the arguments'
+    solids (the builder's ``Modified`` history is empty for solids; ``Images`` holds them)."""
+    cells = shape_index(make_compound(sub_shapes(builder.GetAllParts(), TopAbs_SOLID)), TopAbs_SOLID)
+    owners: list[set[int]] = [set() for _ in range(cells.Size())]
+    images = builder.Images()
+    for i, argument in enumerate(arguments):
+        for solid in sub_shapes(argument, TopAbs_SOLID):
+            for cell in shapes_of(images.Find(solid)) if images.IsBound(solid) else [solid]:
+                k = cells.FindIndex(cell)
+                if k > 0:
+                    owners[k - 1].add(i)
+    return [frozenset(o) for o in owners]
+
+
+def _unified(shape: TopoDS_Shape) -> TopoDS_Shape:
+    unify = ShapeUpgrade_UnifySameDomain(shape, True, True, True)
     unify.Build()
     return unify.Shape()
+
+
+def _valid(shape: TopoDS_Shape) -> bool:
+    return bool(BRepCheck_Analyzer(shape).IsValid())

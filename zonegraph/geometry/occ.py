@@ -111,6 +111,22 @@ def volume_props(shape: TopoDS_Shape) -> tuple[float, np.ndarray]:
     return props.Mass(), xyz(props.CentreOfMass())
 
 
+# Relative error of the Gauss-Kronrod volume integration: far below the IoU's 1e-4, and the
+# integrator converged to it in under 3 ms on the corpus parts measured.
+VOLUME_RTOL = 1e-9
+
+
+def precise_volume(shape: TopoDS_Shape) -> float:
+    """A volume by Gauss-Kronrod integration to ``VOLUME_RTOL``. The default integration
+    (``volume_props``) is only ~1e-4 accurate on surfaces of extrusion: the rebuilt part of
+    ``41941_79d46bb4_0000`` (a spline profile extruded, cuts with the target empty both ways)
+    measured 1.32891 against the target's 1.32909, B-rep IoU 0.99986; both integrate to
+    1.329100 and 1.329096 this way."""
+    props = GProp_GProps()
+    BRepGProp.VolumePropertiesGK_s(shape, props, VOLUME_RTOL)
+    return props.Mass()
+
+
 def surface_props(shape: TopoDS_Shape) -> tuple[float, np.ndarray]:
     props = GProp_GProps()
     BRepGProp.SurfaceProperties_s(shape, props)
