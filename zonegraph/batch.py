@@ -9,12 +9,10 @@ status and one-line reason, and the batch goes on. This module itself imports no
 from __future__ import annotations
 
 import json
-import os
 import sys
 import time
 from collections import Counter
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -123,7 +121,7 @@ def run_batch(job: BatchJob, parts: Sequence[Part], out: Path) -> list[PartRow]:
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     rows = []
-    with _stdout_to_stderr(), tqdm(parts, desc=job.command, unit="part", file=sys.stderr) as bar:
+    with tqdm(parts, desc=job.command, unit="part", file=sys.stderr) as bar:
         for part in bar:
             bar.set_postfix_str(part.name, refresh=True)
             rows.append(_run_part(job, part, out / part.name))
@@ -134,21 +132,6 @@ def run_batch(job: BatchJob, parts: Sequence[Part], out: Path) -> list[PartRow]:
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     print(format_table(job, rows, total, out))
     return rows
-
-
-@contextmanager
-def _stdout_to_stderr() -> Iterator[None]:
-    """Point file descriptor 1 at stderr while the parts run (their children inherit it):
-    OpenCASCADE prints its messages there from C++, and stdout is for the summary table."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    os.dup2(2, 1)
-    try:
-        yield
-    finally:
-        sys.stdout.flush()
-        os.dup2(saved, 1)
-        os.close(saved)
 
 
 def _run_part(job: BatchJob, part: Part, out: Path) -> PartRow:

@@ -14,6 +14,7 @@ from OCP.BRepTools import BRepTools
 
 from zonegraph.console import captured
 from zonegraph.errors import InputError, require_file
+from zonegraph.geometry.occ import precise_volume
 
 
 def read_shape(path: str | Path) -> Shape:
@@ -72,9 +73,7 @@ def symmetric_difference_volume(a: Shape, b: Shape) -> float:
 
 
 def volume_of(shape: Shape | list[Shape] | None) -> float:
-    """Volume of a Boolean result: a shape, a list of shapes (build123d's intersect) or None."""
-    if shape is None:
-        return 0.0
-    if isinstance(shape, Shape):
-        return shape.volume
-    return sum(s.volume for s in shape)
+    """Volume of a Boolean result: a shape, a list of shapes (build123d's intersect) or None,
+    integrated to 1e-9 (:func:`~zonegraph.geometry.occ.precise_volume`)."""
+    shapes = [] if shape is None else [shape] if isinstance(shape, Shape) else shape
+    return sum(precise_volume(s.wrapped) for s in shapes)

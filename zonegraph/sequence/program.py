@@ -22,6 +22,7 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_SHAPE, TopAbs_SOLID
 
 from zonegraph.geometry.cells import select_cells
 from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, precise_volume
+from zonegraph.geometry.shapes import volume_of
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
@@ -243,7 +244,7 @@ ALIKE_RTOL = 1e-4
 
 
 def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
-    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans, volumes by :func:`precise_volume`.
+    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans, volumes by :func:`volume_of`.
 
     A Boolean common of two coincident solids can come back empty although both are valid, and
     which call fails depends on the argument order (on the corpus: common(program, target) empty,
@@ -255,7 +256,7 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
     back with almost no volume."""
     if a is None:
         return 0.0
-    volume_a, volume_b = _volume(a), _volume(b)
+    volume_a, volume_b = volume_of(a), volume_of(b)
     full = (1 - 1e-9) * min(volume_a, volume_b)
     inter = 0.0
     alike = abs(volume_a - volume_b) <= ALIKE_RTOL * max(volume_a, volume_b)
@@ -303,14 +304,8 @@ def _tightened(shape: Shape) -> Shape:
 def _common_volume(a: Shape, b: Shape, fuzzy: float) -> float:
     try:
         if fuzzy <= 0.0:
-            return _volume(a.intersect(b))
+            return volume_of(a.intersect(b))
         return precise_volume(fuzzy_boolean(BRepAlgoAPI_Common(), a.wrapped, b.wrapped, fuzzy))
     except ValueError:  # a null or failed Boolean result
         return 0.0
 
-
-def _volume(shape: Shape | list[Shape] | None) -> float:
-    """The precise volume of a shape or of a Boolean result (a list of shapes from build123d's
-    intersect, or None)."""
-    shapes = [] if shape is None else [shape] if isinstance(shape, Shape) else shape
-    return sum(precise_volume(s.wrapped) for s in shapes)
