@@ -18,6 +18,7 @@ RANK = {
     "errors": 0,
     "console": 0,
     "plugins": 0,
+    "status": 0,
     "geometry": 1,
     "data": 2,
     "zones": 2,
