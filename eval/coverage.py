@@ -20,6 +20,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from zonegraph.status import Status  # noqa: E402
+
 CATEGORIES = (
     "gt_captured",  # reconstructable with the GT sequence
     "other_sequence",  # GT representable on zones, not captured; search finds an exact program
@@ -41,7 +43,12 @@ LABELS = {
     "timeout_or_crash": "timeout or crash",
 }
 COLOURS = dict(zip(CATEGORIES, plt.get_cmap("tab10").colors, strict=False))
-FAILED = {"timeout": "timeout_or_crash", "crash": "timeout_or_crash", "unsupported": "unsupported"}
+FAILED = {
+    Status.TIMEOUT: "timeout_or_crash",
+    Status.CRASH: "timeout_or_crash",
+    Status.UNSUPPORTED: "unsupported",
+}
+GONE = (Status.TIMEOUT, Status.CRASH)  # the job never finished
 
 
 def _true(value: object) -> bool:
@@ -53,17 +60,17 @@ def category(row: pd.Series, graph: str, level: int) -> str:
     """The coverage category of one design row of ``designs.parquet`` for a graph and level."""
     for stage_status in ("convert_status", "replay_status"):
         status = row.get(stage_status)
-        if isinstance(status, str) and status != "ok":
+        if isinstance(status, str) and status != Status.OK:
             return FAILED.get(status, "conversion_or_replay_failed")
     status = row.get("graph_status")
-    if status in ("timeout", "crash"):
+    if status in GONE:
         return "timeout_or_crash"
-    if status != "ok":
+    if status != Status.OK:
         return "zone_graph_failed"
     gt_status = row.get(f"{graph}_status")
-    if gt_status in ("timeout", "crash"):
+    if gt_status in GONE:
         return "timeout_or_crash"
-    if gt_status != "ok":
+    if gt_status != Status.OK:
         return "zone_graph_failed"
     if _true(row.get(f"{graph}_captured_l{level}")):
         return "gt_captured"

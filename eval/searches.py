@@ -23,6 +23,7 @@ import pandas as pd
 from zonegraph.configs import InferConfig
 from zonegraph.isolation import run_isolated
 from zonegraph.reconstruction import infer
+from zonegraph.status import Status
 
 TARGET_SUFFIXES = (".json", ".step", ".stp", ".brep")
 
@@ -63,7 +64,7 @@ def split_targets(split: str, root: str | Path = ".") -> list[Target]:
     """The replayed designs of one split of a pipeline run (``data/replay``, ``data/designs``)."""
     root = Path(root)
     manifest = pd.read_parquet(root / "data/replay/manifest.parquet")
-    rows = manifest[(manifest["split"] == split) & (manifest["status"] == "ok")].sort_values("design_id")
+    rows = manifest[(manifest["split"] == split) & (manifest["status"] == Status.OK)].sort_values("design_id")
     index = root / "data/designs/index.parquet"
     folders: dict[str, str] = {}
     if index.is_file():
@@ -126,7 +127,7 @@ def _run_one(search: Search, records: Path, timeout_s: float) -> dict[str, Any]:
         "folder": search.target.folder,
         "gt_length": search.target.gt_length,
         "fingerprint": fingerprint,
-        "outcome": outcome.status,
+        "outcome": str(outcome.status),  # the job's; a search's own status comes with its values
         "reason": outcome.reason,
         **(outcome.value if outcome.ok and outcome.value else {}),
     }

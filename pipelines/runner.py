@@ -21,6 +21,7 @@ from distributed import Client, as_completed
 from tqdm import tqdm
 
 from zonegraph.isolation import run_isolated
+from zonegraph.status import Status
 
 
 @dataclass(frozen=True)
@@ -79,7 +80,7 @@ def _execute(fn: Callable, job: Job, timeout: float | None) -> dict:
     record = {
         "design_id": job.key,
         "fingerprint": job.fingerprint,
-        "status": outcome.status,
+        "status": str(outcome.status),  # the plain string: records and tables hold no enum objects
         "reason": outcome.reason,
         "seconds": round(outcome.seconds, 4),
     }
@@ -130,7 +131,7 @@ def run_jobs(
                 record = {
                     "design_id": job.key,
                     "fingerprint": job.fingerprint,
-                    "status": "crash",
+                    "status": Status.CRASH.value,
                     "reason": f"{type(exc).__name__}: {exc}",
                     "seconds": 0.0,
                 }

@@ -13,12 +13,12 @@ import zonegraph
 PACKAGE = Path(zonegraph.__file__).parent
 # Each layer may import only layers of a lower rank (and itself); data and zones are siblings.
 # errors, console (capturing native output) and plugins (entry-point groups) import nothing heavy
-# and serve every layer.
+# and serve every layer; status, the vocabulary of outcomes, sits below them all (errors name theirs).
 RANK = {
+    "status": -1,
     "errors": 0,
     "console": 0,
     "plugins": 0,
-    "status": 0,
     "geometry": 1,
     "data": 2,
     "zones": 2,

@@ -13,7 +13,8 @@ import pytest
 from OCP.gp import gp_Dir
 
 from zonegraph.cli import EXIT_BUG, _fail
-from zonegraph.isolation import BUG, KERNEL_ERROR, classify, run_isolated
+from zonegraph.isolation import classify, run_isolated
+from zonegraph.status import Status
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -120,7 +121,7 @@ def test_a_bug_keeps_its_traceback_and_exits_1(capsys):
     """An exception of our own code is not the user's fault: traceback and exit 1. An
     OpenCASCADE exception on the input's geometry is a one-line status."""
     outcome = run_isolated(int, ("not a number",), timeout=30)
-    assert outcome.status == BUG and outcome.reason.startswith("ValueError: invalid literal")
+    assert outcome.status == Status.BUG and outcome.reason.startswith("ValueError: invalid literal")
     assert _fail("part.step", outcome) == EXIT_BUG
     err = capsys.readouterr().err
     assert err.startswith("Traceback") and "ValueError" in err
@@ -129,7 +130,7 @@ def test_a_bug_keeps_its_traceback_and_exits_1(capsys):
         gp_Dir(0, 0, 0)
     except Exception as exc:  # a real kernel exception, raised by OCP
         status, reason, detail = classify(exc)
-    assert status == KERNEL_ERROR and not detail
+    assert status == Status.KERNEL_ERROR and not detail
     assert reason.startswith("OpenCASCADE Standard_ConstructionError")
 
 

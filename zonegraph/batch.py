@@ -20,6 +20,7 @@ from typing import Any
 from zonegraph.errors import InputError, file_problem
 from zonegraph.isolation import Outcome
 from zonegraph.outputs import run_staged, write_record
+from zonegraph.status import Status
 
 PART_SUFFIXES = (".step", ".stp", ".brep", ".json")
 
@@ -60,7 +61,7 @@ class PartRow:
 
     name: str
     target: str
-    status: str
+    status: Status
     ok: bool
     reason: str = ""
     seconds: float = 0.0
@@ -142,7 +143,7 @@ def _run_part(job: BatchJob, part: Part, out: Path) -> PartRow:
         outcome = run_staged(lambda scratch: job.run(part.path, scratch), out)
     if outcome.ok:
         values = job.describe(outcome.value)
-        status = str(values.pop("status"))
+        status = Status(values.pop("status"))
         return PartRow(part.name, str(part.path), status, True, "", round(outcome.seconds, 4), values)
     error = {"target": str(part.path), "status": outcome.status, "reason": outcome.reason}
     if outcome.detail:

@@ -66,9 +66,9 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 def _fail(target: str | Path, outcome: Outcome) -> int:
     """A failed part's message: one line and exit 2 for the input's fault; a bug's traceback and
     exit 1, as a bug is ours to fix, not the user's."""
-    from zonegraph.isolation import BUG
+    from zonegraph.status import Status
 
-    if outcome.status == BUG:
+    if outcome.status == Status.BUG:
         message = f"zonegraph: internal error on {target} (a bug: please report it)"
         print(f"{outcome.detail}{message}", file=sys.stderr)
         return EXIT_BUG
@@ -83,10 +83,10 @@ def _batch(job: Callable[[], BatchJob], args: argparse.Namespace) -> int | None:
 
     if not is_batch(args.targets):
         return None
-    from zonegraph.isolation import BUG
+    from zonegraph.status import Status
 
     rows = run_batch(job(), collect_parts(args.targets), Path(args.out))
-    if any(r.status == BUG for r in rows):
+    if any(r.status == Status.BUG for r in rows):
         return EXIT_BUG
     return EXIT_USER_ERROR if any(not r.ok for r in rows) else 0
 

@@ -9,11 +9,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from zonegraph.status import Status
+
 
 class ZoneGraphError(Exception):
-    """A failure caused by the input, not by a bug: carries the source and a short reason."""
+    """A failure caused by the input, not by a bug: carries the source and a short reason.
 
-    status = "error"
+    Raised as it is (not as a subclass), it says that the input cannot be used at all, as a batch
+    path that names nothing: ``invalid_input``, the input's fault like every status here. A status
+    of its own (it was ``error``) read as a failure of ours, which is ``bug`` and keeps a traceback."""
+
+    status: Status = Status.INVALID_INPUT
 
     def __init__(self, source: str, reason: str):
         super().__init__(f"{source}: {reason}")
@@ -28,7 +34,7 @@ class ZoneGraphError(Exception):
 class InputError(ZoneGraphError):
     """The file cannot be read: missing, corrupt, empty, or of the wrong kind."""
 
-    status = "invalid_input"
+    status = Status.INVALID_INPUT
 
 
 def file_problem(path: Path) -> str | None:
@@ -49,7 +55,7 @@ def require_file(path: Path) -> None:
 class DesignError(ZoneGraphError):
     """A design file is readable but inconsistent (a missing entity, a loop that does not close)."""
 
-    status = "invalid_design"
+    status = Status.INVALID_DESIGN
 
     def __init__(self, design: str, entity: str | None, reason: str):
         where = f"{design} [{entity}]" if entity else design
@@ -65,16 +71,16 @@ class DesignError(ZoneGraphError):
 class UnsupportedFeatureError(DesignError):
     """The design uses something outside the sketch + extrude subset we replay exactly."""
 
-    status = "unsupported"
+    status = Status.UNSUPPORTED
 
 
 class ReplayError(DesignError):
     """OpenCASCADE could not build a step (a Boolean failed or produced no solid)."""
 
-    status = "replay_failed"
+    status = Status.REPLAY_FAILED
 
 
 class ReplayMismatchError(DesignError):
     """The replay ran, but its result disagrees with the design file's own ``properties``."""
 
-    status = "replay_mismatch"
+    status = Status.REPLAY_MISMATCH

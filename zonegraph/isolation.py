@@ -20,14 +20,12 @@ from typing import Any
 
 from zonegraph.console import captured
 from zonegraph.errors import ZoneGraphError
-
-BUG = "bug"  # an exception of our own code: the caller shows its traceback
-KERNEL_ERROR = "kernel_error"  # OpenCASCADE raised on this input's geometry
+from zonegraph.status import Status
 
 
 @dataclass(frozen=True)
 class Outcome:
-    status: str  # "ok", "timeout", "crash", BUG, KERNEL_ERROR or a ZoneGraphError status
+    status: Status  # ok, timeout, crash, bug (its traceback in ``detail``), kernel_error or an error's
     value: Any = None
     reason: str = ""  # one line
     seconds: float = 0.0
@@ -35,10 +33,10 @@ class Outcome:
 
     @property
     def ok(self) -> bool:
-        return self.status == "ok"
+        return self.status == Status.OK
 
 
-def classify(exc: BaseException) -> tuple[str, str, str]:
+def classify(exc: BaseException) -> tuple[Status, str, str]:
     """``(status, one-line reason, traceback)`` of an exception raised by a job.
 
     OpenCASCADE's exceptions (``Standard_Failure`` and its kin, raised through OCP) are failures of
@@ -52,8 +50,8 @@ def classify(exc: BaseException) -> tuple[str, str, str]:
     name = type(exc).__name__
     message = " ".join(str(exc).split()) or "no message"
     if _is_kernel(exc):
-        return KERNEL_ERROR, f"OpenCASCADE {name}: {message}{where}", ""
-    return BUG, f"{name}: {message}{where}", "".join(traceback.format_exception(exc))
+        return Status.KERNEL_ERROR, f"OpenCASCADE {name}: {message}{where}", ""
+    return Status.BUG, f"{name}: {message}{where}", "".join(traceback.format_exception(exc))
 
 
 def _is_kernel(exc: BaseException) -> bool:
@@ -68,7 +66,7 @@ def _child(conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...]) -> N
     neither belongs on the user's terminal."""
     try:
         with captured():
-            conn.send(("ok", fn(*args), "", ""))
+            conn.send((Status.OK, fn(*args), "", ""))
     except BaseException as exc:  # noqa: BLE001 - every outcome, bugs included, goes to the parent
         status, reason, detail = classify(exc)
         conn.send((status, None, reason, detail))
@@ -91,13 +89,13 @@ def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -
         if not recv.poll(timeout):
             proc.kill()
             return Outcome(
-                "timeout", reason=f"no result after {timeout:g} s", seconds=time.perf_counter() - t0
+                Status.TIMEOUT, reason=f"no result after {timeout:g} s", seconds=time.perf_counter() - t0
             )
         status, value, reason, detail = recv.recv()
     except EOFError:
         proc.join()
         return Outcome(
-            "crash", reason=f"worker died (exit code {proc.exitcode})", seconds=time.perf_counter() - t0
+            Status.CRASH, reason=f"worker died (exit code {proc.exitcode})", seconds=time.perf_counter() - t0
         )
     finally:
         recv.close()
@@ -127,9 +125,9 @@ def _run_inline(fn: Callable, args: tuple) -> Outcome:
     (debuggable where it happened) and the console is not captured."""
     t0 = time.perf_counter()
     try:
-        return Outcome("ok", fn(*args), "", time.perf_counter() - t0)
+        return Outcome(Status.OK, fn(*args), "", time.perf_counter() - t0)
     except Exception as exc:
         status, reason, _ = classify(exc)
-        if status == BUG:
+        if status == Status.BUG:
             raise
         return Outcome(status, None, reason, time.perf_counter() - t0)

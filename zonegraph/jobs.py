@@ -20,6 +20,7 @@ from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.ground_truth import ground_truth, search_op
 from zonegraph.sequence.labels import GTOperation, label_design, label_tables
 from zonegraph.sequence.rankers import HeuristicRanker
+from zonegraph.status import Status
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.sampling import export_zone_mesh
@@ -114,7 +115,7 @@ def ground_truth_and_coverage(
         if not gt.captured(1):
             result = search(g, HeuristicRanker(), SearchConfig(budget_s=search_budget_s))
             exact = result.exact
-        out[f"{name}_status"] = "ok"
+        out[f"{name}_status"] = Status.OK
         out[f"{name}_zones"] = g.n_zones
         out[f"{name}_reaches_target"] = gt.reaches_target
         for level in levels:

@@ -27,6 +27,7 @@ from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.program import RebuildError, brep_iou, build_program, execute
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
+from zonegraph.status import Status
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.storage import load_zone_graph
@@ -57,7 +58,7 @@ class Reconstruction:
 class InferResult:
     """What ``zonegraph infer`` found: the contents of ``result.json``."""
 
-    status: str  # exact, partial or rebuild_failed
+    status: Status  # exact, partial or rebuild_failed
     exact: bool  # rebuilt with B-rep IoU >= EXACT_IOU (a zone sliver short of the target can be)
     iou_zone: float
     iou_brep: float
@@ -80,7 +81,8 @@ class InferResult:
     trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
 
     def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
+        """Plain data (the status as its string), for ``result.json`` and the pipeline's tables."""
+        return {**asdict(self), "status": self.status.value}
 
 
 def _search_config(config: InferConfig, budget_s: float) -> SearchConfig:
@@ -236,7 +238,7 @@ def infer(
         write_outputs(export.script, export.design, program, states, out_dir, unit, render)
     exact = bool(iou >= EXACT_IOU)  # the rebuilt B-rep decides, not the zones it was found on
     result = InferResult(
-        status="rebuild_failed" if rebuild_error else "exact" if exact else "partial",
+        status=Status.REBUILD_FAILED if rebuild_error else Status.EXACT if exact else Status.PARTIAL,
         exact=exact,
         iou_zone=rec.result.iou,
         iou_brep=iou,

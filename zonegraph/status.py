@@ -2,8 +2,8 @@
 
 A status is a plain string on disk (Parquet, JSON), so that tables stay readable without this
 package; in code it is a member of :class:`Status`, so that a misspelt status fails at import
-instead of silently counting as a failure. Like :mod:`zonegraph.errors`, this module imports
-nothing and serves every layer.
+instead of silently counting as a failure. This module imports nothing and serves every layer,
+:mod:`zonegraph.errors` included (each error class names its status).
 """
 
 from __future__ import annotations

@@ -3,16 +3,15 @@
 ``extension`` and ``face_loops`` choose the extended surfaces, ``build`` runs the general fuse and
 checks the invariants, ``model`` holds the resulting arrays (:class:`ZoneGraph`), ``sampling``
 draws the zones' surface samples and ``storage`` saves and loads a graph as Parquet + BREP.
-Imports only :mod:`zonegraph.geometry` and :mod:`zonegraph.errors`.
+Imports only :mod:`zonegraph.geometry`, :mod:`zonegraph.errors` and :mod:`zonegraph.status`.
 """
 
 from zonegraph.zones.build import build_zone_graph
-from zonegraph.zones.model import BuildStatus, ZoneGraph, ZoneGraphBuildError
+from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.sampling import export_zone_mesh, sample_zone_surfaces
 from zonegraph.zones.storage import load_zone_graph, save_zone_graph
 
 __all__ = [
-    "BuildStatus",
     "ZoneGraph",
     "ZoneGraphBuildError",
     "build_zone_graph",

@@ -45,11 +45,11 @@ from zonegraph.geometry.occ import (
     volume_props,
     xyz,
 )
+from zonegraph.status import Status
 from zonegraph.zones.extension import ExtendedSurface, SurfaceKind, canonical, extend_faces, parallel
 from zonegraph.zones.model import (
     BOX_VOLUME_RTOL,
     TARGET_VOLUME_RTOL,
-    BuildStatus,
     ZoneGraph,
     ZoneGraphBuildError,
 )
@@ -86,11 +86,11 @@ def _target_shape(target: Target, source: str) -> TopoDS_Shape:
     items: Sequence[Shape | TopoDS_Shape] = target if isinstance(target, (list, tuple)) else [target]
     shapes = [getattr(t, "wrapped", t) for t in items]
     if not shapes or any(s is None or s.IsNull() for s in shapes):
-        raise ZoneGraphBuildError(BuildStatus.INVALID_INPUT, source, "empty shape")
+        raise ZoneGraphBuildError(Status.INVALID_INPUT, source, "empty shape")
     solids = [s for shape in shapes for s in sub_shapes(shape, TopAbs_SOLID)]
     if not solids:
         raise ZoneGraphBuildError(
-            BuildStatus.NOT_A_SOLID, source, "no solid in the shape (a sheet, wire or empty file?)"
+            Status.NOT_A_SOLID, source, "no solid in the shape (a sheet, wire or empty file?)"
         )
     return make_compound(solids)
 
@@ -131,7 +131,7 @@ def _perform(algo: BOPAlgo_Builder, fuzzy: float, source: str, name: str) -> BOP
     algo.SetNonDestructive(True)
     algo.Perform()
     if algo.HasErrors():
-        raise ZoneGraphBuildError(BuildStatus.FUSE_FAILED, source, f"{name} reported errors")
+        raise ZoneGraphBuildError(Status.FUSE_FAILED, source, f"{name} reported errors")
     return algo
 
 
@@ -219,12 +219,12 @@ def build_zone_graph(
     solids = sub_shapes(target_n, TopAbs_SOLID)
     target_volume = sum(volume_props(s)[0] for s in solids)
     if not target_volume > 0:
-        raise ZoneGraphBuildError(BuildStatus.INVALID_INPUT, source, "target has no volume")
+        raise ZoneGraphBuildError(Status.INVALID_INPUT, source, "target has no volume")
     box = bounds(target_n)
     surfaces, n_target_faces = extend_faces(target_n, box, simplify)
     timer.lap("extend_s")
     info = {
-        "status": "ok",
+        "status": Status.OK,
         "simplified": simplify,
         "target_faces": n_target_faces,
         "target_solids": len(solids),
@@ -240,7 +240,7 @@ def build_zone_graph(
                 graph.check(source)
             break
         except ZoneGraphBuildError as exc:
-            if attempt == len(ladder) - 1 or exc.status == BuildStatus.INVALID_INPUT.value:
+            if attempt == len(ladder) - 1 or exc.status == Status.INVALID_INPUT:
                 raise
     if not keep_solids:
         graph.solids = None

@@ -8,7 +8,6 @@ is a graph edge, a face on the box boundary has ``-1`` as its second zone.
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,6 +16,7 @@ from scipy.sparse.csgraph import connected_components
 
 from zonegraph.errors import ZoneGraphError
 from zonegraph.geometry.normalize import Normalization
+from zonegraph.status import Status
 
 BOX_VOLUME_RTOL = 1e-6
 TARGET_VOLUME_RTOL = 1e-4
@@ -26,23 +26,12 @@ MESH_BOX_RTOL = 1e-5
 MESH_TARGET_RTOL = 1e-3
 
 
-class BuildStatus(str, enum.Enum):
-    OK = "ok"
-    INVALID_INPUT = "invalid_input"
-    NOT_A_SOLID = "not_a_solid"
-    FUSE_FAILED = "fuse_failed"
-    TARGET_MISMATCH = "target_mismatch"
-    NO_INTERIOR_POINT = "no_interior_point"
-    DISCONNECTED = "disconnected"
-    TIMEOUT = "timeout"
-
-
 class ZoneGraphBuildError(ZoneGraphError):
     """A zone graph could not be built or broke an invariant; ``status`` says which."""
 
-    def __init__(self, status: BuildStatus, source: str, reason: str):
+    def __init__(self, status: Status, source: str, reason: str):
         super().__init__(source, reason)
-        self.status = status.value
+        self.status = status
 
 
 @dataclass(repr=False)
@@ -130,17 +119,17 @@ class ZoneGraph:
         box_ratio = float(self.zone_volume.sum()) / self.box_volume
         if not _close(box_ratio, self.info.get("mesh_box_ratio"), BOX_VOLUME_RTOL, MESH_BOX_RTOL):
             raise ZoneGraphBuildError(
-                BuildStatus.FUSE_FAILED, source, f"zone volumes sum to {box_ratio:.9f} of the box"
+                Status.FUSE_FAILED, source, f"zone volumes sum to {box_ratio:.9f} of the box"
             )
         if not np.isfinite(self.zone_interior).all():
             missing = int((~np.isfinite(self.zone_interior).all(axis=1)).sum())
             raise ZoneGraphBuildError(
-                BuildStatus.NO_INTERIOR_POINT, source, f"{missing} zones have no interior point"
+                Status.NO_INTERIOR_POINT, source, f"{missing} zones have no interior point"
             )
         target_ratio = self.inside_volume / self.target_volume
         if not _close(target_ratio, self.info.get("mesh_target_ratio"), TARGET_VOLUME_RTOL, MESH_TARGET_RTOL):
             raise ZoneGraphBuildError(
-                BuildStatus.TARGET_MISMATCH,
+                Status.TARGET_MISMATCH,
                 source,
                 f"inside zones hold {target_ratio:.6f} of the target volume",
             )
@@ -149,7 +138,7 @@ class ZoneGraph:
             adj = coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(self.n_zones,) * 2)
             n, _ = connected_components(adj, directed=False)
             if n != 1:
-                raise ZoneGraphBuildError(BuildStatus.DISCONNECTED, source, f"zone graph has {n} components")
+                raise ZoneGraphBuildError(Status.DISCONNECTED, source, f"zone graph has {n} components")
 
     def summary(self) -> dict:
         return {
