@@ -1,6 +1,6 @@
 """Zone graph statistics (paper fig. 4): zone count vs face count, build time vs zone count.
 
-python -m eval.zone_stats [MANIFEST] [--out DIR]
+python -m eval.zone_stats MANIFEST --out DIR
 """
 
 from __future__ import annotations
@@ -16,10 +16,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from zonegraph.status import Status  # noqa: E402
+
 
 def plot_zone_stats(manifest: pd.DataFrame, out: Path) -> dict:
     out.mkdir(parents=True, exist_ok=True)
-    ok = manifest[manifest["status"] == "ok"]
+    ok = manifest[manifest["status"] == Status.OK]
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     axes[0].scatter(ok["faces_in"], ok["zones"], s=8, alpha=0.6)
     axes[0].set(xlabel="B-rep face count", ylabel="zone count", yscale="log", title="Zones vs faces")
@@ -63,8 +65,8 @@ def _describe(values: pd.Series) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("manifest", nargs="?", default="data/zonegraphs/manifest.parquet")
-    parser.add_argument("--out", default="data/plots/zonegraphs")
+    parser.add_argument("manifest", help="the zonegraphs stage's manifest.parquet")
+    parser.add_argument("--out", required=True, help="the folder for the plots and stats")
     args = parser.parse_args()
     stats = plot_zone_stats(pd.read_parquet(args.manifest), Path(args.out))
     print(

@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 from typing import Any
@@ -25,13 +26,11 @@ from zonegraph.data.dataset import DesignRecord, read_dataset, stratified_sample
 from zonegraph.data.design import load_design
 from zonegraph.data.stats import design_statistics, format_comparison, timeline_folder
 from zonegraph.data.synthetic import design_seed, generate_design, synthetic_id
+from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import load_params
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
-
-OUT = Path("data/designs")
-METRICS = Path("data/metrics/conversion.json")
 
 
 def write_design(design_id: str, seed: int, path: str) -> dict[str, Any]:
@@ -59,8 +58,8 @@ def convert_to_json(batch: str, design_id: str, path: str, timeout_s: float) -> 
     }
 
 
-def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
-    json_dir = OUT / "json"
+def generate(count: int, seed: int, dask_cfg: dict, timeout: float, out: Path) -> Path:
+    json_dir = out / "json"
     json_dir.mkdir(parents=True, exist_ok=True)
     code = code_fingerprint("generate")
     jobs = []
@@ -68,19 +67,21 @@ def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
         name, s = synthetic_id(i), design_seed(seed, i)
         jobs.append(Job(name, fingerprint(code, s), (name, s, str(json_dir / f"{name}.json"))))
     with dask_client(dask_cfg) as client:
-        records = run_jobs(write_design, jobs, OUT / "records", client, timeout, "generate")
+        records = run_jobs(write_design, jobs, out / "records", client, timeout, "generate")
     for r in records:
-        if r["status"] != "ok":
+        if r["status"] != Status.OK:
             print(f"generate: {r['design_id']} failed ({r['status']}): {r['reason']}")
             (json_dir / f"{r['design_id']}.json").unlink(missing_ok=True)
     return json_dir
 
 
-def convert_corpus(root: Path, limit: int | None, seed: int, dask_cfg: dict, timeout: float) -> pd.DataFrame:
+def convert_corpus(
+    root: Path, limit: int | None, seed: int, dask_cfg: dict, timeout: float, out: Path
+) -> pd.DataFrame:
     """Convert (a stratified sample of) the corpus; returns one row per design, failures included."""
     entries = list_corpus(root)
     entries = [entries[i] for i in stratified_sample([e.folder for e in entries], limit, seed)]
-    json_dir = OUT / "json"
+    json_dir = out / "json"
     json_dir.mkdir(parents=True, exist_ok=True)
     code = code_fingerprint("generate")
     jobs = [
@@ -92,23 +93,23 @@ def convert_corpus(root: Path, limit: int | None, seed: int, dask_cfg: dict, tim
         for e in entries
     ]
     with dask_client(dask_cfg) as client:  # the child's own alarm fires first; the kill is the backstop
-        records = run_jobs(convert_to_json, jobs, OUT / "convert_records", client, timeout + 30, "convert")
+        records = run_jobs(convert_to_json, jobs, out / "convert_records", client, timeout + 30, "convert")
     table = pd.DataFrame(records).drop(columns=["fingerprint"])
     table["folder"] = [e.folder for e in entries]
-    failed = table["status"] != "ok"  # the child itself timed out or crashed
+    failed = table["status"] != Status.OK  # the child itself timed out or crashed
     table.loc[failed, "convert_status"] = table.loc[failed, "status"]
     table.loc[failed, "convert_reason"] = table.loc[failed, "reason"]
     for row in table.itertuples():
-        if row.convert_status != "ok":
+        if row.convert_status != Status.OK:
             (json_dir / f"{row.design_id}.json").unlink(missing_ok=True)
     return table.drop(columns=["status", "reason"]).rename(
         columns={"convert_status": "status", "convert_reason": "reason"}
     )
 
 
-def write_conversion(table: pd.DataFrame) -> None:
-    table.to_parquet(OUT / "conversion.parquet", index=False)
-    ok = table["status"] == "ok"
+def write_conversion(table: pd.DataFrame, out: Path, metrics_file: Path) -> None:
+    table.to_parquet(out / "conversion.parquet", index=False)
+    ok = table["status"] == Status.OK
     metrics = {
         "source": "b123d",
         "designs": int(len(table)),
@@ -116,13 +117,13 @@ def write_conversion(table: pd.DataFrame) -> None:
         "rate": float(ok.mean()) if len(table) else 0.0,
         "by_status": {k: int(v) for k, v in table["status"].value_counts().items()},
         "by_folder": {
-            f: {"designs": int(len(g)), "converted": int((g["status"] == "ok").sum())}
+            f: {"designs": int(len(g)), "converted": int((g["status"] == Status.OK).sum())}
             for f, g in table.groupby("folder")
         },
         "median_seconds": float(table["seconds"].median()) if len(table) else None,
     }
-    METRICS.parent.mkdir(parents=True, exist_ok=True)
-    METRICS.write_text(json.dumps(metrics, indent=2))
+    metrics_file.parent.mkdir(parents=True, exist_ok=True)
+    metrics_file.write_text(json.dumps(metrics, indent=2))
     print(
         f"convert: {metrics['converted']}/{metrics['designs']} converted and verified "
         f"({metrics['rate']:.2%}), by status {metrics['by_status']}"
@@ -130,6 +131,10 @@ def write_conversion(table: pd.DataFrame) -> None:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, required=True, help="the designs folder (index.parquet, json/)")
+    parser.add_argument("--metrics", type=Path, required=True, help="the conversion metrics JSON")
+    args = parser.parse_args()
     params = load_params()
     data = params["data"]
     source = data.get("source", "synthetic")
@@ -145,30 +150,33 @@ def main() -> None:
             int(data.get("limit_seed", 0)),
             params["dask"],
             float(data.get("convert_timeout_s", 120)),
+            args.out,
         )
-        write_conversion(table)
-        folder = OUT / "json"
+        write_conversion(table, args.out, args.metrics)
+        folder = args.out / "json"
     elif source == "synthetic":
         syn = params["synthetic"]
-        folder = generate(int(syn["count"]), int(syn["seed"]), params["dask"], float(syn["timeout_s"]))
+        folder = generate(
+            int(syn["count"]), int(syn["seed"]), params["dask"], float(syn["timeout_s"]), args.out
+        )
     else:
         raise SystemExit(f"generate: unknown data.source {source!r} (synthetic, fusion_json or b123d)")
     if source == "b123d":  # this run's converted designs (the folder may hold earlier runs' too)
-        ids = sorted(table.loc[table["status"] == "ok", "design_id"])
+        ids = sorted(table.loc[table["status"] == Status.OK, "design_id"])
         test = test_ids(ids, seed, fraction)
         records = [DesignRecord(i, folder / f"{i}.json", "test" if i in test else "train") for i in ids]
     else:
         records = read_dataset(folder, seed=seed, test_fraction=fraction)
     if source == "fusion_json" and limit is not None:
         records = [records[i] for i in stratified_sample(["all"] * len(records), limit, seed)]
-    write_index(records, table if source == "b123d" else None)
+    write_index(records, table if source == "b123d" else None, args.out)
     if source != "b123d":  # nothing converted: the metric says so
-        METRICS.parent.mkdir(parents=True, exist_ok=True)
-        METRICS.write_text(json.dumps({"source": source, "designs": len(records)}, indent=2))
+        args.metrics.parent.mkdir(parents=True, exist_ok=True)
+        args.metrics.write_text(json.dumps({"source": source, "designs": len(records)}, indent=2))
     print(f"generate: {len(records)} designs from {folder} ({source})")
 
 
-def write_index(records: list[DesignRecord], table: pd.DataFrame | None) -> None:
+def write_index(records: list[DesignRecord], table: pd.DataFrame | None, out: Path) -> None:
     designs, folders = [], []
     for r in records:
         try:
@@ -188,11 +196,11 @@ def write_index(records: list[DesignRecord], table: pd.DataFrame | None) -> None
     )
     if table is not None:  # the corpus's own timeline folders
         index["folder"] = index["design_id"].map(table.set_index("design_id")["folder"])
-    OUT.mkdir(parents=True, exist_ok=True)
-    index.to_parquet(OUT / "index.parquet", index=False)
+    out.mkdir(parents=True, exist_ok=True)
+    index.to_parquet(out / "index.parquet", index=False)
     stats = design_statistics(designs)
-    (OUT / "stats.json").write_text(json.dumps(stats, indent=2))
-    (OUT / "stats.txt").write_text(format_comparison(stats) + "\n")
+    (out / "stats.json").write_text(json.dumps(stats, indent=2))
+    (out / "stats.txt").write_text(format_comparison(stats) + "\n")
     print(f"generate: splits {index['split'].value_counts().to_dict()}")
 
 

@@ -12,6 +12,7 @@ zone ids, captured and proposal count at each level, mapping check, reason),
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
@@ -19,47 +20,54 @@ import pandas as pd
 
 from eval.coverage import CATEGORIES, coverage_table, plot_coverage, to_markdown
 from zonegraph.jobs import ground_truth_and_coverage
+from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import load_params
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
-OUT = Path("data/gt")
-PLOTS = Path("data/plots")
-METRICS = Path("data/metrics/coverage.json")
 
-
-def designs_table() -> pd.DataFrame:
+def designs_table(designs: Path, replayed: Path, zonegraphs: Path) -> pd.DataFrame:
     """Every design of the run with the status of each earlier stage (conversion when present)."""
-    index = pd.read_parquet("data/designs/index.parquet")[["design_id", "split", "folder"]]
-    replay = pd.read_parquet("data/replay/manifest.parquet")
-    replay = replay[["design_id", "status", "error", "steps", "operations", "brep_dir"]]
-    replay = replay.rename(columns={"status": "replay_status", "error": "replay_reason"})
-    graphs = pd.read_parquet("data/zonegraphs/manifest.parquet")[["design_id", "status", "reason", "zones"]]
+    index = pd.read_parquet(designs / "index.parquet")[["design_id", "split", "folder"]]
+    replay = pd.read_parquet(replayed / "manifest.parquet")
+    replay = replay[["design_id", "status", "reason", "steps", "operations", "brep_dir"]]
+    replay = replay.rename(columns={"status": "replay_status", "reason": "replay_reason"})
+    graphs = pd.read_parquet(zonegraphs / "manifest.parquet")[["design_id", "status", "reason", "zones"]]
     graphs = graphs.rename(
         columns={"status": "graph_status", "reason": "graph_reason", "zones": "graph_zones"}
     )
     table = index.merge(replay, on="design_id", how="left").merge(graphs, on="design_id", how="left")
-    conversion = Path("data/designs/conversion.parquet")
+    conversion = designs / "conversion.parquet"
     if conversion.is_file():  # corpus runs: designs that never became JSON count too
         conv = pd.read_parquet(conversion)[["design_id", "folder", "status", "reason"]]
         conv = conv.rename(columns={"status": "convert_status", "reason": "convert_reason"})
-        failed = conv[conv["convert_status"] != "ok"].assign(split="none")
-        table = pd.concat([table.assign(convert_status="ok", convert_reason=""), failed], ignore_index=True)
+        failed = conv[conv["convert_status"] != Status.OK].assign(split="none")
+        table = pd.concat(
+            [table.assign(convert_status=Status.OK.value, convert_reason=""), failed], ignore_index=True
+        )
     return table
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--designs", type=Path, required=True, help="the generate stage's folder")
+    parser.add_argument("--replay", type=Path, required=True, help="the replay stage's folder")
+    parser.add_argument("--zonegraphs", type=Path, required=True, help="the zonegraphs stage's folder")
+    parser.add_argument("--out", type=Path, required=True, help="the ground truth folder")
+    parser.add_argument("--plot", type=Path, required=True, help="the coverage plot (PNG)")
+    parser.add_argument("--metrics", type=Path, required=True, help="the coverage metrics JSON")
+    args = parser.parse_args()
     params = load_params()
     cfg = params["ground_truth"]
     levels = tuple(int(k) for k in cfg["levels"])
-    table = designs_table()
-    todo = table[table["graph_status"] == "ok"]
+    table = designs_table(args.designs, args.replay, args.zonegraphs)
+    todo = table[table["graph_status"] == Status.OK]
     code = code_fingerprint("ground_truth")
     settings = (levels, float(cfg["search_budget_s"]), bool(cfg["full_graph"]))
     jobs = []
     for row in todo.itertuples():
-        graph = Path("data/zonegraphs/graphs") / row.design_id
+        graph = args.zonegraphs / "graphs" / row.design_id
         ops = row.operations.split(",")
         jobs.append(
             Job(
@@ -71,13 +79,18 @@ def main() -> None:
         )
     with dask_client(params["dask"]) as client:
         records = run_jobs(
-            ground_truth_and_coverage, jobs, OUT / "records", client, float(cfg["timeout_s"]), "ground_truth"
+            ground_truth_and_coverage,
+            jobs,
+            args.out / "records",
+            client,
+            float(cfg["timeout_s"]),
+            "ground_truth",
         )
     steps = [dict(step, design_id=r["design_id"]) for r in records for step in r.get("steps", [])]
-    OUT.mkdir(parents=True, exist_ok=True)
-    pd.DataFrame(steps).to_parquet(OUT / "steps.parquet", index=False)
+    args.out.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame(steps).to_parquet(args.out / "steps.parquet", index=False)
     results = pd.DataFrame([{k: v for k, v in r.items() if k != "steps"} for r in records])
-    failed = results["status"] != "ok"  # the whole job timed out or crashed
+    failed = results["status"] != Status.OK  # the whole job timed out or crashed
     for graph in ("simplified", "full"):
         column = f"{graph}_status"
         if column not in results:
@@ -87,20 +100,22 @@ def main() -> None:
         columns={"seconds": "gt_seconds"}
     )
     designs = table.merge(results, on="design_id", how="left")
-    designs.to_parquet(OUT / "designs.parquet", index=False)
-    write_coverage(designs, levels)
+    designs.to_parquet(args.out / "designs.parquet", index=False)
+    write_coverage(designs, levels, args.out, args.plot, args.metrics)
 
 
-def write_coverage(designs: pd.DataFrame, levels: tuple[int, ...]) -> None:
+def write_coverage(
+    designs: pd.DataFrame, levels: tuple[int, ...], out: Path, plot: Path, metrics_file: Path
+) -> None:
     variants = {
         f"{graph} graph, level {level}": (graph, level)
         for graph in ("simplified", "full")
         for level in levels
     }
     tables = {name: coverage_table(designs, graph, level) for name, (graph, level) in variants.items()}
-    (OUT / "coverage.md").write_text(to_markdown(tables))
+    (out / "coverage.md").write_text(to_markdown(tables))
     first = next(iter(tables))
-    plot_coverage(tables[first], PLOTS / "coverage.png", f"Coverage ({first}), {len(designs)} designs")
+    plot_coverage(tables[first], plot, f"Coverage ({first}), {len(designs)} designs")
     seconds = designs["gt_seconds"].dropna()
     metrics = {
         "designs": int(len(designs)),
@@ -108,8 +123,8 @@ def write_coverage(designs: pd.DataFrame, levels: tuple[int, ...]) -> None:
         "seconds_per_design_mean": float(seconds.mean()) if len(seconds) else None,
         **{name: {c: int(t.loc[c, "all"]) for c in CATEGORIES} for name, t in tables.items()},
     }
-    METRICS.parent.mkdir(parents=True, exist_ok=True)
-    METRICS.write_text(json.dumps(metrics, indent=2))
+    metrics_file.parent.mkdir(parents=True, exist_ok=True)
+    metrics_file.write_text(json.dumps(metrics, indent=2))
     t = tables[first]
     share = t["all"] / max(int(t["all"].sum()), 1)
     print(

@@ -13,6 +13,7 @@ killable Dask task that writes its own shards, ``data/labels/proposals/<id>.parq
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
@@ -20,14 +21,11 @@ import pandas as pd
 
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.jobs import label_and_save
+from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import load_params
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
-
-OUT = Path("data/labels")
-GRAPHS = Path("data/zonegraphs/graphs")
-METRICS = Path("data/metrics/labels.json")
 
 
 def saved_graph_rows(steps: pd.DataFrame) -> pd.DataFrame:
@@ -40,7 +38,7 @@ def saved_graph_rows(steps: pd.DataFrame) -> pd.DataFrame:
 def candidates(designs: pd.DataFrame, splits: list[str], limit: int | None, seed: int) -> pd.DataFrame:
     """Designs to label: the chosen splits, GT replayed to the target; a seeded stratified sample."""
     reaches = designs["simplified_reaches_target"].where(
-        designs["simplified_status"] == "ok", designs["full_reaches_target"]
+        designs["simplified_status"] == Status.OK, designs["full_reaches_target"]
     )
     chosen = designs[designs["split"].isin(splits) & (reaches == True)]  # noqa: E712 (nullable)
     chosen = chosen.sort_values("design_id").reset_index(drop=True)
@@ -48,13 +46,20 @@ def candidates(designs: pd.DataFrame, splits: list[str], limit: int | None, seed
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--gt", type=Path, required=True, help="the ground_truth stage's folder")
+    parser.add_argument("--zonegraphs", type=Path, required=True, help="the zonegraphs stage's folder")
+    parser.add_argument("--out", type=Path, required=True, help="the labels folder (shards, records)")
+    parser.add_argument("--metrics", type=Path, required=True, help="the label metrics JSON")
+    args = parser.parse_args()
+    out, graphs = args.out, args.zonegraphs / "graphs"
     params = load_params()
     cfg = params["labels"]
     level, seed = int(cfg["level"]), int(cfg["seed"])
     splits = list(cfg["splits"])
     rank_splits = [s for s in cfg.get("rank_splits") or [] if s not in splits]
-    designs = pd.read_parquet("data/gt/designs.parquet")
-    steps = saved_graph_rows(pd.read_parquet("data/gt/steps.parquet"))
+    designs = pd.read_parquet(args.gt / "designs.parquet")
+    steps = saved_graph_rows(pd.read_parquet(args.gt / "steps.parquet"))
     column = f"captured_l{level}"
     if column not in steps:
         raise SystemExit(f"labels: level {level} is not among ground_truth.levels ({column} missing)")
@@ -84,14 +89,14 @@ def main() -> None:
         Job(
             row.design_id,
             fingerprint(
-                code, settings(row.split), row.split, gt_of[row.design_id], files=(GRAPHS / row.design_id,)
+                code, settings(row.split), row.split, gt_of[row.design_id], files=(graphs / row.design_id,)
             ),
             (
-                str(GRAPHS / row.design_id),
+                str(graphs / row.design_id),
                 gt_of[row.design_id],
                 row.design_id,
                 row.split,
-                str(OUT),
+                str(out),
                 *settings(row.split),
             ),
             cost=float(row.graph_zones),
@@ -100,17 +105,17 @@ def main() -> None:
         if row.design_id in gt_of
     ]
     with dask_client(params["dask"]) as client:
-        records = run_jobs(label_and_save, jobs, OUT / "records", client, float(cfg["timeout_s"]), "labels")
-    keep = {r["design_id"] for r in records if r["status"] == "ok"}
-    for shard in [*OUT.glob("proposals/*.parquet"), *OUT.glob("steps/*.parquet")]:
+        records = run_jobs(label_and_save, jobs, out / "records", client, float(cfg["timeout_s"]), "labels")
+    keep = {r["design_id"] for r in records if r["status"] == Status.OK}
+    for shard in [*out.glob("proposals/*.parquet"), *out.glob("steps/*.parquet")]:
         if shard.stem not in keep:  # a failed design or one of an earlier, different run
             shard.unlink()
     split_of = dict(zip(todo["design_id"], todo["split"], strict=True))
     table = pd.DataFrame(records)
     ranked = table["design_id"].map(split_of).isin(rank_splits) if len(table) else pd.Series(dtype=bool)
     metrics = {**count(table[~ranked]), "rank_only": count(table[ranked])}
-    METRICS.parent.mkdir(parents=True, exist_ok=True)
-    METRICS.write_text(json.dumps(metrics, indent=2))
+    args.metrics.parent.mkdir(parents=True, exist_ok=True)
+    args.metrics.write_text(json.dumps(metrics, indent=2))
     print(
         f"labels: {metrics['labelled']}/{metrics['designs']} designs, {metrics['labelled_steps']} steps, "
         f"{metrics['proposals']} proposals (+{metrics['positives']} / 0 {metrics['neutrals']} / "
@@ -118,13 +123,13 @@ def main() -> None:
         f"{metrics['rank_only']['labelled']}/{metrics['rank_only']['designs']} designs "
         f"({', '.join(rank_splits) or 'none'}), {metrics['rank_only']['labelled_steps']} steps"
     )
-    for row in table[table["status"] != "ok"].itertuples():
+    for row in table[table["status"] != Status.OK].itertuples():
         print(f"  {row.design_id}: {row.status}: {row.reason}")
 
 
 def count(records: pd.DataFrame) -> dict:
     """Designs, steps and labels of a set of job records, with the time they took."""
-    ok = records[records["status"] == "ok"] if len(records) else records
+    ok = records[records["status"] == Status.OK] if len(records) else records
     counts = ("steps", "labelled_steps", "proposals", "positives", "negatives", "neutrals", "completions")
     return {
         "designs": int(len(records)),

@@ -10,6 +10,7 @@ stage saved (zone-graph build time is excluded from the budget, as in the paper)
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
@@ -18,13 +19,13 @@ import pandas as pd
 
 from zonegraph.configs import InferConfig
 from zonegraph.reconstruction import infer
+from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import load_params
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
-OUT = Path("data/reconstruct")
-METRICS = Path("data/metrics/reconstruct.json")
+SEARCHED = (Status.EXACT, Status.PARTIAL, Status.REBUILD_FAILED)  # a search ran and gave a program
 
 
 def reconstruct_design(target: str, out: str, config: InferConfig, saved_graph: str) -> dict:
@@ -38,7 +39,7 @@ def reconstruct_design(target: str, out: str, config: InferConfig, saved_graph: 
 def summarise(results: pd.DataFrame) -> dict:
     metrics = {}
     for guide, rows in results.groupby("guide"):
-        ok = rows[rows["status"].isin(["exact", "partial", "rebuild_failed"])]
+        ok = rows[rows["status"].isin([s.value for s in SEARCHED])]
         exact = ok[ok["exact"].astype(bool)]
         metrics[guide] = {
             "designs": int(len(rows)),
@@ -54,11 +55,17 @@ def summarise(results: pd.DataFrame) -> dict:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--replay", type=Path, required=True, help="the replay stage's folder")
+    parser.add_argument("--zonegraphs", type=Path, required=True, help="the zonegraphs stage's folder")
+    parser.add_argument("--out", type=Path, required=True, help="the reconstructions folder")
+    parser.add_argument("--metrics", type=Path, required=True, help="the reconstruction metrics JSON")
+    args = parser.parse_args()
     params = load_params()
     cfg = params["reconstruct"]
-    replayed = pd.read_parquet("data/replay/manifest.parquet")
-    test = replayed[(replayed["split"] == "test") & (replayed["status"] == "ok")]
-    zones = pd.read_parquet("data/zonegraphs/manifest.parquet").set_index("design_id")["zones"].fillna(0)
+    replayed = pd.read_parquet(args.replay / "manifest.parquet")
+    test = replayed[(replayed["split"] == "test") & (replayed["status"] == Status.OK)]
+    zones = pd.read_parquet(args.zonegraphs / "manifest.parquet").set_index("design_id")["zones"].fillna(0)
     code = code_fingerprint("reconstruct")
     jobs = []
     for guide in cfg["guides"]:
@@ -66,25 +73,25 @@ def main() -> None:
         model = (cfg["model"],) if guide == "net" and cfg.get("model") else ()  # its weights count too
         for row in test.itertuples():
             brep = f"{row.brep_dir}/final.brep"
-            graph = Path("data/zonegraphs/graphs") / row.design_id
+            graph = args.zonegraphs / "graphs" / row.design_id
             jobs.append(
                 Job(
                     f"{guide}__{row.design_id}",
                     fingerprint(code, repr(config), files=(brep, graph, *model)),
-                    (brep, str(OUT / guide / row.design_id), config, str(graph)),
+                    (brep, str(args.out / guide / row.design_id), config, str(graph)),
                     cost=float(zones.get(row.design_id, 0)),
                 )
             )
     with dask_client(params["dask"]) as client:
         records = run_jobs(
-            reconstruct_design, jobs, OUT / "records", client, float(cfg["timeout_s"]), "reconstruct"
+            reconstruct_design, jobs, args.out / "records", client, float(cfg["timeout_s"]), "reconstruct"
         )
     results = pd.DataFrame(records).drop(columns=["fingerprint"])
     results[["guide", "design_id"]] = results["design_id"].str.split("__", n=1, expand=True)
-    results.to_parquet(OUT / "results.parquet", index=False)
+    results.to_parquet(args.out / "results.parquet", index=False)
     metrics = summarise(results)
-    METRICS.parent.mkdir(parents=True, exist_ok=True)
-    METRICS.write_text(json.dumps(metrics, indent=2))
+    args.metrics.parent.mkdir(parents=True, exist_ok=True)
+    args.metrics.write_text(json.dumps(metrics, indent=2))
     for guide, m in metrics.items():
         print(
             f"reconstruct [{guide}]: exact {m['exact_rate']:.1%} of {m['designs']}, mean B-rep IoU "

@@ -1,11 +1,12 @@
 """DVC stage ``replay``: every design -> final and per-step B-reps plus a Parquet manifest.
 
-B-reps are BREP files in the design's centimetres: ``data/replay/breps/<id>/final.brep``,
+B-reps are BREP files in the design's centimetres: ``breps/<id>/final.brep`` of the output folder,
 ``NN.brep`` (all bodies after extrude NN) and ``NN_tool.brep`` (that extrude's tool body).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
@@ -15,13 +16,11 @@ import pandas as pd
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.geometry.shapes import write_brep
+from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import load_params
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
-
-OUT = Path("data/replay")
-METRICS = Path("data/metrics/replay.json")
 
 
 def replay_design(path: str, out_dir: str) -> dict:
@@ -50,26 +49,30 @@ def replay_design(path: str, out_dir: str) -> dict:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--designs", type=Path, required=True, help="the generate stage's folder")
+    parser.add_argument("--out", type=Path, required=True, help="the replay folder (manifest, breps)")
+    parser.add_argument("--metrics", type=Path, required=True, help="the replay metrics JSON")
+    args = parser.parse_args()
     params = load_params()
-    index = pd.read_parquet("data/designs/index.parquet")
+    index = pd.read_parquet(args.designs / "index.parquet")
     code = code_fingerprint("replay")
     jobs = [
         Job(
             row.design_id,
             fingerprint(code, files=(row.path,)),
-            (row.path, str(OUT / "breps" / row.design_id)),
+            (row.path, str(args.out / "breps" / row.design_id)),
         )
         for row in index.itertuples()
     ]
     with dask_client(params["dask"]) as client:
         records = run_jobs(
-            replay_design, jobs, OUT / "records", client, float(params["replay"]["timeout_s"]), "replay"
+            replay_design, jobs, args.out / "records", client, float(params["replay"]["timeout_s"]), "replay"
         )
     manifest = pd.DataFrame(records).drop(columns=["fingerprint"])
     manifest.insert(1, "split", index["split"].to_numpy())
-    manifest = manifest.rename(columns={"reason": "error"})
-    manifest.to_parquet(OUT / "manifest.parquet", index=False)
-    ok = manifest["status"] == "ok"
+    manifest.to_parquet(args.out / "manifest.parquet", index=False)
+    ok = manifest["status"] == Status.OK
     metrics = {
         "designs": int(len(manifest)),
         "ok": int(ok.sum()),
@@ -77,11 +80,11 @@ def main() -> None:
         "median_seconds": float(np.median(manifest["seconds"])) if len(manifest) else 0.0,
         "max_volume_rel_error": float(manifest.loc[ok, "volume_rel_error"].max()) if ok.any() else None,
     }
-    METRICS.parent.mkdir(parents=True, exist_ok=True)
-    METRICS.write_text(json.dumps(metrics, indent=2))
+    args.metrics.parent.mkdir(parents=True, exist_ok=True)
+    args.metrics.write_text(json.dumps(metrics, indent=2))
     print(f"replay: {metrics['ok']}/{metrics['designs']} designs ok, failures {metrics['failed']}")
     for row in manifest.loc[~ok].itertuples():
-        print(f"  {row.design_id}: {row.status}: {row.error}")
+        print(f"  {row.design_id}: {row.status}: {row.reason}")
 
 
 if __name__ == "__main__":

@@ -1,12 +1,13 @@
 """DVC stage ``zonegraphs``: every replayed design's final solid -> its zone graph.
 
-Graphs go to ``data/zonegraphs/graphs/<id>/`` (see ``zonegraph.zone_io``); the manifest
-``data/zonegraphs/manifest.parquet`` has one row per design (status, reason, target faces, zones,
+Graphs go to ``graphs/<id>/`` of the output folder (see ``zonegraph.zones.storage``); the manifest
+``manifest.parquet`` beside them has one row per design (status, reason, target faces, zones,
 edges, build seconds, simplified), designs that failed to replay included with their status.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
@@ -15,51 +16,52 @@ import pandas as pd
 
 from zonegraph.configs import BuildConfig
 from zonegraph.jobs import build_and_save
+from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import load_params
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
-OUT = Path("data/zonegraphs")
-METRICS = Path("data/metrics/zonegraphs.json")
-
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--replay", type=Path, required=True, help="the replay stage's folder")
+    parser.add_argument("--out", type=Path, required=True, help="the zone graphs folder (manifest, graphs)")
+    parser.add_argument("--metrics", type=Path, required=True, help="the zone graph metrics JSON")
+    args = parser.parse_args()
     params = load_params()
     cfg = params["zonegraph"]
-    replayed = pd.read_parquet("data/replay/manifest.parquet")
-    ok = replayed[replayed["status"] == "ok"]
+    replayed = pd.read_parquet(args.replay / "manifest.parquet")
+    ok = replayed[replayed["status"] == Status.OK]
     code = code_fingerprint("zonegraphs")
     config = BuildConfig.from_mapping(cfg)
     jobs = [
         Job(
             row.design_id,
             fingerprint(code, repr(config), files=(f"{row.brep_dir}/final.brep",)),
-            (f"{row.brep_dir}/final.brep", str(OUT / "graphs" / row.design_id), config),
+            (f"{row.brep_dir}/final.brep", str(args.out / "graphs" / row.design_id), config),
             cost=row.faces,
         )
         for row in ok.itertuples()
     ]
     with dask_client(params["dask"]) as client:
         records = run_jobs(
-            build_and_save, jobs, OUT / "records", client, float(cfg["timeout_s"]), "zonegraphs"
+            build_and_save, jobs, args.out / "records", client, float(cfg["timeout_s"]), "zonegraphs"
         )
     built = pd.DataFrame(records).drop(columns=["fingerprint"])
-    skipped = replayed.loc[replayed["status"] != "ok", ["design_id", "status", "error"]].rename(
-        columns={"error": "reason"}
-    )
+    skipped = replayed.loc[replayed["status"] != Status.OK, ["design_id", "status", "reason"]]
     manifest = pd.concat([built, skipped], ignore_index=True)
     manifest = manifest.merge(replayed[["design_id", "split"]], on="design_id")
     manifest = manifest.rename(
         columns={"target_faces": "faces_in", "faces": "partition_faces", "seconds": "job_seconds"}
     )
     manifest["simplified"] = config.simplify
-    manifest.to_parquet(OUT / "manifest.parquet", index=False)
-    write_metrics(manifest)
+    manifest.to_parquet(args.out / "manifest.parquet", index=False)
+    write_metrics(manifest, args.metrics)
 
 
-def write_metrics(manifest: pd.DataFrame) -> None:
-    ok = manifest["status"] == "ok"
+def write_metrics(manifest: pd.DataFrame, metrics_file: Path) -> None:
+    ok = manifest["status"] == Status.OK
     build = manifest.loc[ok, "build_s"].to_numpy(float)
     metrics = {
         "designs": int(len(manifest)),
@@ -69,8 +71,8 @@ def write_metrics(manifest: pd.DataFrame) -> None:
         "p90_build_s": float(np.percentile(build, 90)) if len(build) else None,
         "median_zones": float(manifest.loc[ok, "zones"].median()) if ok.any() else None,
     }
-    METRICS.parent.mkdir(parents=True, exist_ok=True)
-    METRICS.write_text(json.dumps(metrics, indent=2))
+    metrics_file.parent.mkdir(parents=True, exist_ok=True)
+    metrics_file.write_text(json.dumps(metrics, indent=2))
     print(
         f"zonegraphs: {metrics['ok']}/{metrics['designs']} ok, median build {metrics['median_build_s']} s, "
         f"by status {metrics['by_status']}"

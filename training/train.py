@@ -287,11 +287,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--params", default="params.yaml")
     parser.add_argument("--device", default=None, help="cpu, cuda or auto (default: params)")
+    parser.add_argument("--labels", default=None, help="the labels folder (default: params)")
+    parser.add_argument("--graphs", default=None, help="the saved zone graphs folder (default: params)")
+    parser.add_argument("--out", default=None, help="the folder for the model (default: params)")
     args = parser.parse_args()
     with open(args.params) as f:
         values = yaml.safe_load(f).get("train", {})
     if args.device:
         values["device"] = args.device
+    paths = {"labels_dir": args.labels, "graphs_dir": args.graphs, "out_dir": args.out}
+    values.update({k: v for k, v in paths.items() if v})  # the train stage's, from dvc.yaml
     best = train(TrainConfig.from_mapping(values))
     print(f"train: best epoch {best['epoch']}, validation relative GT rank {best['val_rank']:.4f}")
 

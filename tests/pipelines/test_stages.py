@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shlex
 import subprocess
 import sys
 
@@ -10,10 +11,16 @@ import pandas as pd
 import pyarrow.dataset as ds
 import yaml
 
+from pipelines.runner import PROJECT
+
 
 def run_stage(module: str, cwd) -> str:
+    """Run the stage of ``dvc.yaml`` whose command runs ``module``, with that command's paths."""
+    stages = yaml.safe_load((PROJECT / "dvc.yaml").read_text())["stages"]
+    commands = [shlex.split(s["cmd"]) for s in stages.values()]
+    words = next(c for c in commands if c[:3] == ["python", "-m", module])
     proc = subprocess.run(
-        [sys.executable, "-m", module], cwd=cwd, capture_output=True, text=True, timeout=600
+        [sys.executable, *words[1:]], cwd=cwd, capture_output=True, text=True, timeout=600
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
     return proc.stdout
