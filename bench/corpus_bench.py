@@ -30,6 +30,7 @@ from zonegraph.configs import InferConfig
 from zonegraph.data.b123d import CorpusEntry, convert_design, list_corpus
 from zonegraph.isolation import run_isolated
 from zonegraph.reconstruction import infer
+from zonegraph.status import Status
 
 
 def sample(corpus: Path, per_folder: int, seed: int, keep: set[str] | None = None) -> list[CorpusEntry]:
@@ -84,7 +85,9 @@ def summarise(rows: list[dict]) -> str:
     for folder in groups:
         rs = [r for r in rows if folder in ("all", r["folder"])]
         converted = [r for r in rs if not str(r.get("status", "")).startswith("convert_")]
-        searched = [r for r in converted if r.get("status") in ("exact", "partial", "rebuild_failed")]
+        searched = [
+            r for r in converted if r.get("status") in (Status.EXACT, Status.PARTIAL, Status.REBUILD_FAILED)
+        ]
         exact = [r for r in searched if r.get("exact")]
         iou = (
             np.mean([r.get("iou_brep", 0.0) if r in searched else 0.0 for r in converted]) if converted else 0
@@ -95,7 +98,7 @@ def summarise(rows: list[dict]) -> str:
             f"| {folder} | {len(converted)} | {len(searched) / max(len(converted), 1):.0%} | "
             f"{len(exact) / max(len(converted), 1):.0%} | {iou:.3f} | {tte} | {zones} |"
         )
-    failures = [r for r in rows if r.get("status") not in ("exact", "partial")]
+    failures = [r for r in rows if r.get("status") not in (Status.EXACT, Status.PARTIAL)]
     lines.append("")
     for r in failures:
         lines.append(f"- {r['design_id']} ({r['folder']}): {r.get('status')}: {r.get('reason', '')[:160]}")

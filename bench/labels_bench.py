@@ -33,6 +33,7 @@ from zonegraph.data.replay import replay
 from zonegraph.isolation import run_isolated
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.labels import NEGATIVE, NEUTRAL, POSITIVE, GTOperation, label_design
+from zonegraph.status import Status
 from zonegraph.zones.build import build_zone_graph
 
 CORPUS_SIZE, CLUSTER_CORES = 7483, 16
@@ -67,7 +68,7 @@ def _label(entry: CorpusEntry, work: str, seed: int, level: int, multiplier: flo
     )
     labels = [x.label for st in steps for x in st.proposals]
     return {
-        "status": "ok",
+        "status": Status.OK.value,
         "zones": graph.n_zones,
         "steps": len(steps),
         "labelled_steps": sum(bool(st.proposals) for st in steps),
@@ -97,14 +98,17 @@ def corpus_mean(rows: list[dict], timeout: float, population: dict[str, int]) ->
     for folder, size in population.items():
         rs = [r for r in rows if r["folder"] == folder]
         if rs:
-            cost = [r["label_s"] if r["status"] == "ok" else timeout * (r["status"] == "timeout") for r in rs]
+            cost = [
+                r["label_s"] if r["status"] == Status.OK else timeout * (r["status"] == Status.TIMEOUT)
+                for r in rs
+            ]
             total, weight = total + size * float(np.mean(cost)), weight + size
     return total / max(weight, 1)
 
 
 def summarise(rows: list[dict], timeout: float, population: dict[str, int]) -> str:
-    ok = [r for r in rows if r["status"] == "ok"]
-    timed_out = [r for r in rows if r["status"] == "timeout"]
+    ok = [r for r in rows if r["status"] == Status.OK]
+    timed_out = [r for r in rows if r["status"] == Status.TIMEOUT]
     lines = [
         "| folder | designs | labelled | median s | p90 s | max s | s per labelled step | proposals | "
         "completions/s | + / 0 / - |",
@@ -144,7 +148,7 @@ def summarise(rows: list[dict], timeout: float, population: dict[str, int]) -> s
             f"{r['steps']} steps, {r['proposals']} proposals, {r['completions']} completions"
         )
     for r in rows:
-        if r["status"] != "ok":
+        if r["status"] != Status.OK:
             lines.append(
                 f"- {r['design_id']} ({r['folder']}): {r['status']}: {str(r.get('reason', ''))[:160]}"
             )
