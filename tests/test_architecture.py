@@ -13,7 +13,7 @@ import zonegraph
 PACKAGE = Path(zonegraph.__file__).parent
 # Each layer may import only layers of a lower rank (and itself); data and zones are siblings, as
 # are export and network.
-# errors, console (capturing native output) and plugins (entry-point groups) import nothing heavy
+# errors, console (capturing native output) and plugins (the guides, by name) import nothing heavy
 # and serve every layer.
 RANK = {
     "errors": 0,

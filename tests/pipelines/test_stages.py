@@ -3,17 +3,27 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pandas as pd
 import pyarrow.dataset as ds
 import yaml
 
+ROOT = Path(__file__).resolve().parents[2]  # the stage scripts are the checkout's, not installed
+
 
 def run_stage(module: str, cwd) -> str:
+    path = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)
     proc = subprocess.run(
-        [sys.executable, "-m", module], cwd=cwd, capture_output=True, text=True, timeout=600
+        [sys.executable, "-m", module],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={**os.environ, "PYTHONPATH": path},
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
     return proc.stdout
