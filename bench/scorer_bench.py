@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from training.data import geometry_of
-from training.model import ModelConfig, ProposalScorer
-from training.scoring import score_state
+from zonegraph.network.encoding import geometry_of
+from zonegraph.network.model import ModelConfig, ProposalScorer
+from zonegraph.network.scoring import score_state
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.sequence.rankers import HeuristicRanker
 from zonegraph.zones.model import ZoneGraph

@@ -11,8 +11,9 @@ from pathlib import Path
 import zonegraph
 
 PACKAGE = Path(zonegraph.__file__).parent
-# Each layer may import only layers of a lower rank (and itself); data and zones are siblings.
-# errors, console (capturing native output) and plugins (entry-point groups) import nothing heavy
+# Each layer may import only layers of a lower rank (and itself); data and zones are siblings, as
+# are export and network.
+# errors, console (capturing native output) and plugins (the guides, by name) import nothing heavy
 # and serve every layer; status, the vocabulary of outcomes, sits below them all (errors name theirs).
 RANK = {
     "status": -1,
@@ -24,8 +25,13 @@ RANK = {
     "zones": 2,
     "sequence": 3,
     "export": 4,
+    "network": 4,  # the network guide at inference: model, encoding, checkpoint, ranker
 }
 TOP = 5  # reconstruction, cli, batch, jobs, isolation, outputs, configs and the package root
+# The one layer that may import these, and which no other imports at module level: the rest reach
+# the network guide through zonegraph.plugins, by reference, so a core install never needs torch.
+TORCH = ("torch", "torch_geometric")
+TORCH_LAYER = "network"
 
 
 def _layer(module: str) -> str:
@@ -37,25 +43,71 @@ def _rank(layer: str) -> int:
     return RANK.get(layer, TOP)
 
 
+def _names(node: ast.AST) -> set[str]:
+    if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+        return {node.module}
+    if isinstance(node, ast.Import):
+        return {a.name for a in node.names}
+    return set()
+
+
 def _imports(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text())
-    found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            found.add(node.module)
-        elif isinstance(node, ast.Import):
-            found.update(a.name for a in node.names)
+    return {name for node in ast.walk(ast.parse(path.read_text())) for name in _names(node)}
+
+
+def _eager_imports(path: Path) -> set[str]:
+    """The imports that run when the module is imported: module level, outside functions and
+    ``if TYPE_CHECKING:`` blocks."""
+    found: set[str] = set()
+    pending: list[ast.AST] = list(ast.parse(path.read_text()).body)
+    while pending:
+        node = pending.pop()
+        found |= _names(node)
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            pending.extend(node.orelse)
+        elif not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.Lambda):
+            pending.extend(ast.iter_child_nodes(node))
     return found
+
+
+def _modules() -> list[tuple[str, Path]]:
+    return [
+        (".".join(("zonegraph", *path.relative_to(PACKAGE).with_suffix("").parts)), path)
+        for path in PACKAGE.rglob("*.py")
+    ]
+
+
+def test_only_the_network_layer_imports_torch_and_nothing_imports_it_eagerly():
+    bad = []
+    for module, path in _modules():
+        if _layer(module) == TORCH_LAYER:
+            continue
+        for imported in _imports(path):
+            if imported.split(".")[0] in TORCH:
+                bad.append(f"{module} imports {imported}")
+        for imported in _eager_imports(path):
+            if imported == f"zonegraph.{TORCH_LAYER}" or imported.startswith(f"zonegraph.{TORCH_LAYER}."):
+                bad.append(f"{module} imports {imported} at module level")
+    assert not bad, "torch outside zonegraph.network:\n" + "\n".join(sorted(bad))
+
+
+def test_the_package_and_the_cli_help_load_no_torch():
+    code = (
+        "import sys, contextlib, io, zonegraph, zonegraph.network, zonegraph.plugins, zonegraph.cli\n"
+        "zonegraph.plugins.available_guides()\n"
+        "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+        "    zonegraph.cli.main(['infer', '--help'])\n"
+        "print(sorted(m for m in ('torch', 'torch_geometric') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["[]"]
 
 
 def test_imports_run_one_way():
     bad = []
-    for path in PACKAGE.rglob("*.py"):
-        module = ".".join(("zonegraph", *path.relative_to(PACKAGE).with_suffix("").parts))
+    for module, path in _modules():
         layer = _layer(module)
         for imported in _imports(path):
-            if imported.split(".")[0] == "torch":
-                bad.append(f"{module} imports torch")
             if not imported.startswith("zonegraph."):
                 continue
             other = _layer(imported)

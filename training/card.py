@@ -1,6 +1,6 @@
 """The model card of a checkpoint: what it was trained on, how, and how well it ranks.
 
-    python -m training.card models/scorer.pt --out training/checkpoints/MODEL_CARD.md
+    python -m training.card models/scorer.pt --out zonegraph/network/checkpoints/MODEL_CARD.md
         [--test-ranks eval_out/rank.json] [--note "free text"]
 
 Everything is read from the checkpoint (:func:`training.train.save_checkpoint` stores the model

@@ -34,9 +34,9 @@ from torch_geometric.loader import DataLoader
 
 from training.data import LabelDataset
 from training.loss import focal_loss
-from training.model import ModelConfig, ProposalScorer
-from training.scoring import score_state
 from zonegraph.data.dataset import project_of, test_ids
+from zonegraph.network.model import ModelConfig, ProposalScorer
+from zonegraph.network.scoring import score_state
 from zonegraph.sequence.rankers import relative_rank
 
 DEFAULT_TRACKING = "sqlite:///mlflow.db"
@@ -235,7 +235,8 @@ def train(config: TrainConfig) -> dict[str, Any]:
 def save_checkpoint(
     model: ProposalScorer, config: TrainConfig, metrics: dict, path: Path, provenance: dict | None = None
 ) -> None:
-    """Weights with everything a model card needs: configs, best metrics, data and code versions."""
+    """Weights with everything a model card needs: configs, best metrics, data and code versions
+    (read back by :func:`zonegraph.network.checkpoint.scorer_from`)."""
     torch.save(
         {
             "model": config.model.to_dict(),
@@ -246,18 +247,6 @@ def save_checkpoint(
         },
         path,
     )
-
-
-def load_scorer(path: str | Path, device: str = "cpu") -> ProposalScorer:
-    """A trained scorer in eval mode."""
-    return scorer_from(torch.load(path, map_location=device, weights_only=True), device)
-
-
-def scorer_from(checkpoint: dict, device: str = "cpu") -> ProposalScorer:
-    """The scorer a loaded checkpoint holds, in eval mode."""
-    model = ProposalScorer(ModelConfig(**checkpoint["model"]))
-    model.load_state_dict(checkpoint["state_dict"])
-    return model.eval().to(device)
 
 
 def write_curves(curve: list[dict], out: Path) -> None:

@@ -145,22 +145,19 @@ def _cmd_build(args: argparse.Namespace) -> int:
 
 def _guide_error(config: InferConfig) -> str | None:
     """Why the guide or its model cannot be used, checked before the kernel is imported."""
-    from zonegraph.plugins import available_guides
+    from zonegraph.plugins import guide_problem
 
-    guides = available_guides()
-    if config.guide not in guides:
-        extra = (
-            " (net needs the train extra: pip install 'zonegraph[train]')" if config.guide == "net" else ""
-        )
-        return f"unknown guide {config.guide!r}: {', '.join(guides)}{extra}"
+    problem = guide_problem(config.guide)
+    if problem is not None:
+        return problem
     if config.model is not None and not Path(config.model).is_file():
         return f"{config.model}: no such model checkpoint"
     return None
 
 
 def _infer_job(config: InferConfig, timeout: float) -> BatchJob:
-    """``infer`` in a killable child per part; a plugin guide's package (torch) is imported here
-    too, so that a batch's children inherit it instead of importing it each."""
+    """``infer`` in a killable child per part; a shipped or plugin guide's package (torch) is
+    imported here too, so that a batch's children inherit it instead of importing it each."""
     from zonegraph.batch import BatchJob, Column
     from zonegraph.isolation import run_isolated
     from zonegraph.plugins import guide_factory

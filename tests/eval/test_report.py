@@ -13,8 +13,8 @@ import pandas as pd
 from eval.searches import Search, folder_targets, run_searches
 from tests.conftest import requires_samples
 from tests.mlflow_server import mlflow_server, rest, search_runs
-from training.ranker import SHIPPED
 from zonegraph.configs import InferConfig
+from zonegraph.network.checkpoint import SHIPPED
 
 PARTS = ["Couch.json", "Pattern4-SteppedStartEndFace_17dd857d_0000.json"]
 

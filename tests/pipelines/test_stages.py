@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import shlex
 import subprocess
 import sys
@@ -19,8 +20,14 @@ def run_stage(module: str, cwd) -> str:
     stages = yaml.safe_load((PROJECT / "dvc.yaml").read_text())["stages"]
     commands = [shlex.split(s["cmd"]) for s in stages.values()]
     words = next(c for c in commands if c[:3] == ["python", "-m", module])
-    proc = subprocess.run(
-        [sys.executable, *words[1:]], cwd=cwd, capture_output=True, text=True, timeout=600
+    path = os.pathsep.join(p for p in (str(PROJECT), os.environ.get("PYTHONPATH")) if p)
+    proc = subprocess.run(  # the stage scripts are the checkout's, not installed
+        [sys.executable, *words[1:]],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={**os.environ, "PYTHONPATH": path},
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
     return proc.stdout

@@ -15,14 +15,16 @@ from pipelines.ablations import train_variant, variants
 from tests.conftest import gt_rows, requires_samples
 from tests.mlflow_server import mlflow_server, search_runs
 from training.card import card
-from training.data import LabelDataset, geometry_of, state_data
+from training.data import LabelDataset
 from training.loss import focal_loss
-from training.model import ModelConfig, ProposalScorer
-from training.train import TrainConfig, forward, load_scorer, train
+from training.train import TrainConfig, forward, train
 from zonegraph.data.dataset import project_of
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.jobs import label_and_save
+from zonegraph.network.checkpoint import SHIPPED, load_scorer
+from zonegraph.network.encoding import geometry_of, state_data
+from zonegraph.network.model import ModelConfig, ProposalScorer
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.proposals import ProposalGenerator
@@ -130,7 +132,7 @@ def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_pat
     assert {"train_loss", "val_loss", "val_rank", "best_val_rank"} <= names
     tags = {t["key"]: t["value"] for t in run["data"]["tags"]}
     assert len(tags["data_version"]) == 12 and tags["git_commit"]
-    # The network guide: a plugin ranker the core reaches without importing torch.
+    # The network guide: a ranker the core reaches by reference, without importing torch.
     ranker = make_ranker("net", model=str(tmp_path / "models" / "scorer.pt"))
     graph = build_zone_graph(list(replay(load_design(samples_dir / "Couch.json")).bodies), samples=128)
     proposals = ProposalGenerator(graph).proposals(np.zeros(graph.n_zones, bool))
@@ -150,7 +152,7 @@ def test_geometry_of_keeps_seeded_samples_and_both_edge_directions(samples_dir):
 @requires_samples
 @pytest.mark.parametrize("fusion", ["early", "late"])
 def test_a_state_scored_in_chunks_scores_as_in_one_pass(samples_dir, monkeypatch, fusion):
-    from training import scoring
+    from zonegraph.network import scoring
 
     graph = build_zone_graph(list(replay(load_design(samples_dir / "Couch.json")).bodies), samples=16)
     canvas = np.zeros(graph.n_zones, bool)
@@ -169,8 +171,6 @@ def test_a_state_scored_in_chunks_scores_as_in_one_pass(samples_dir, monkeypatch
 
 @requires_samples
 def test_the_shipped_checkpoint_guides_without_a_model_path_and_has_its_card(samples_dir):
-    from training.ranker import SHIPPED
-
     checkpoint = torch.load(SHIPPED, weights_only=True)
     assert SHIPPED.stat().st_size < 5e6
     card_text = (SHIPPED.parent / "MODEL_CARD.md").read_text()

@@ -13,7 +13,7 @@ from typing import Protocol
 
 import numpy as np
 
-from zonegraph.plugins import available_guides, guide_factory
+from zonegraph.plugins import guide_factory, guide_problem
 from zonegraph.sequence.proposals import Proposal
 from zonegraph.zones.model import ZoneGraph
 
@@ -72,27 +72,26 @@ class HeuristicRanker:
 
 
 def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
-    """The ranker a guide name stands for: ``heuristic``, ``random`` (seeded), or a plugin.
+    """The ranker a guide name stands for: ``heuristic``, ``random`` (seeded), or one that
+    :mod:`zonegraph.plugins` loads by reference.
 
-    Plugins are entry points in the ``zonegraph.rankers`` group, called with ``model`` and
-    ``seed``: this is how ``net`` (``training.ranker:NetworkRanker``) reaches the search without
-    the core importing torch.
+    Those are called with ``model`` and ``seed``: the network guide ``net``
+    (:class:`zonegraph.network.ranker.NetworkRanker`, with the train extra) and the entry points
+    of installed packages in the ``zonegraph.rankers`` group. This is how they reach the search
+    without this layer importing torch.
 
     Raises:
-        ValueError: an unknown guide, or a plugin guide whose package is not installed.
+        ValueError: an unknown guide, or a shipped guide whose extra is not installed.
     """
     if guide == "heuristic":
         return HeuristicRanker()
     if guide == "random":
         return RandomRanker(seed)
     factory = guide_factory(guide)
-    if factory is not None:
-        ranker: Ranker = factory(model=model, seed=seed)
-        return ranker
-    hint = (
-        " (the network guide needs the train extra: pip install 'zonegraph[train]')" if guide == "net" else ""
-    )
-    raise ValueError(f"unknown guide {guide!r}: {', '.join(available_guides())}{hint}")
+    if factory is None:
+        raise ValueError(guide_problem(guide) or f"unknown guide {guide!r}")
+    ranker: Ranker = factory(model=model, seed=seed)
+    return ranker
 
 
 def relative_rank(scores: np.ndarray, is_gt: np.ndarray) -> float:

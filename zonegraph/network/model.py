@@ -64,7 +64,7 @@ class PointNet(nn.Module):
         points: (N, C, S) for N zones of S samples with C channels; returns (N, hidden).
     """
 
-    def __init__(self, channels: int, hidden: int = HIDDEN):
+    def __init__(self, channels: int, hidden: int = HIDDEN) -> None:
         super().__init__()
         self.points = nn.Sequential(
             nn.Conv1d(channels, 64, 1),
@@ -84,7 +84,7 @@ class PointNet(nn.Module):
 class ZoneMessages(MessagePassing):
     """One round: a zone's new code is an MLP of its code and the mean of its neighbours' codes."""
 
-    def __init__(self, hidden: int = HIDDEN):
+    def __init__(self, hidden: int = HIDDEN) -> None:
         super().__init__(aggr="mean")
         self.mlp = _mlp([2 * hidden, hidden, hidden, hidden])
 
@@ -98,13 +98,13 @@ class ZoneMessages(MessagePassing):
 class ProposalScorer(nn.Module):
     """Two logits per proposal (negative, positive); :meth:`score` gives P(positive).
 
-    Reads a PyG batch of states (``training.data.StateData``): ``x`` (N, 4) flags of the N zone
+    Reads a PyG batch of states (``zonegraph.network.encoding.StateData``): ``x`` (N, 4) flags of the N zone
     copies (one copy of a state's zones per proposal), ``edge_index`` between them, ``proposal``
     (N,) the proposal of each, ``zone_of`` (N,) its row of ``points`` (Z, 6, S), the states' zones
     with ``zone_edge_index`` between them.
     """
 
-    def __init__(self, config: ModelConfig = ModelConfig()):
+    def __init__(self, config: ModelConfig = ModelConfig()) -> None:
         super().__init__()
         self.config = config
         h = config.hidden

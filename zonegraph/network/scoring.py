@@ -13,8 +13,8 @@ import torch
 from torch import Tensor
 from torch_geometric.data import Batch
 
-from training.data import Geometry, state_data
-from training.model import ProposalScorer
+from zonegraph.network.encoding import Geometry, state_data
+from zonegraph.network.model import ProposalScorer
 
 MAX_POINTS = 1_000_000  # zone samples per forward pass (early fusion)
 MAX_NODES = 200_000  # zone copies per forward pass (late and factored fusion)

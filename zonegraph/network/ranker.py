@@ -1,9 +1,10 @@
 """The network guide: a trained scorer behind the search's ``Ranker`` protocol.
 
-Registered as the ``net`` entry point of the ``zonegraph.rankers`` group (``pyproject.toml``), so
-``zonegraph infer PART --guide net`` and ``make_ranker("net")`` find it while ``zonegraph/`` never
-imports torch. The model is loaded once; with late fusion a graph's zone geometry is encoded once
-and every state's proposals are scored in one batched pass, in eval mode.
+:mod:`zonegraph.plugins` names it as the ``net`` guide by reference, and offers it only where
+torch and torch_geometric can be found, so ``zonegraph infer PART --guide net`` and
+``make_ranker("net")`` import this module (and torch) only when the guide is used. The model is
+loaded once; with late fusion a graph's zone geometry is encoded once and every state's proposals
+are scored in one batched pass, in eval mode.
 """
 
 from __future__ import annotations
@@ -13,14 +14,12 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from training.data import Geometry, geometry_of
-from training.model import ProposalScorer
-from training.scoring import score_state
-from training.train import scorer_from
+from zonegraph.network.checkpoint import SHIPPED, read_checkpoint, scorer_from
+from zonegraph.network.encoding import Geometry, geometry_of
+from zonegraph.network.model import ProposalScorer
+from zonegraph.network.scoring import score_state
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.zones.model import ZoneGraph
-
-SHIPPED = Path(__file__).resolve().parent / "checkpoints" / "scorer.pt"
 
 
 class NetworkRanker:
@@ -28,13 +27,13 @@ class NetworkRanker:
 
     samples = 128  # surface samples per zone the search builds graphs with: the checkpoint's own
 
-    def __init__(self, model: str | Path | None = None, seed: int = 0, device: str = "cpu"):
+    def __init__(self, model: str | Path | None = None, seed: int = 0, device: str = "cpu") -> None:
         path = Path(model) if model else SHIPPED
         if not path.is_file():
-            raise ValueError(f"{path}: no model checkpoint (train one: python -m training.train)")
+            raise ValueError(f"{path}: no model checkpoint (in a checkout: python -m training.train)")
         torch.manual_seed(seed)
         self.device = torch.device(device)
-        checkpoint = torch.load(path, map_location=device, weights_only=True)
+        checkpoint = read_checkpoint(path, device)
         self.model: ProposalScorer = scorer_from(checkpoint, device)
         self.samples = int(checkpoint["train"].get("points_per_zone") or self.samples)
         self._graph: ZoneGraph | None = None

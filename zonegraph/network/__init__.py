@@ -1,0 +1,53 @@
+"""The network guide at inference: the proposal scorer, its input encoding, checkpoint loading,
+the ranker and the shipped checkpoint (paper sec. 4.2).
+
+Layout (issue 22): everything a user of ``--guide net`` needs lives here, inside the one
+installed package, so ``pip install 'zonegraph[train]'`` is enough to run it; the training loop,
+the loss, the label dataset and the model card writer stay in the checkout's ``training/``
+folder, run with ``python -m`` like the pipeline's stages. This is the one layer that imports
+torch and torch_geometric; nothing outside it imports it eagerly (:mod:`zonegraph.plugins` names
+the ranker by reference), and this ``__init__`` imports its names on first use, so
+``import zonegraph.network`` alone loads no torch either.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+_EXPORTS = {
+    "ModelConfig": "zonegraph.network.model",
+    "ProposalScorer": "zonegraph.network.model",
+    "Geometry": "zonegraph.network.encoding",
+    "StateData": "zonegraph.network.encoding",
+    "geometry_of": "zonegraph.network.encoding",
+    "state_data": "zonegraph.network.encoding",
+    "score_state": "zonegraph.network.scoring",
+    "SHIPPED": "zonegraph.network.checkpoint",
+    "load_scorer": "zonegraph.network.checkpoint",
+    "scorer_from": "zonegraph.network.checkpoint",
+    "NetworkRanker": "zonegraph.network.ranker",
+}
+
+__all__ = sorted(_EXPORTS)
+
+if TYPE_CHECKING:
+    from zonegraph.network.checkpoint import SHIPPED, load_scorer, scorer_from
+    from zonegraph.network.encoding import Geometry, StateData, geometry_of, state_data
+    from zonegraph.network.model import ModelConfig, ProposalScorer
+    from zonegraph.network.ranker import NetworkRanker
+    from zonegraph.network.scoring import score_state
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name from its module on first use (PEP 562): torch loads only then."""
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'zonegraph.network' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
