@@ -13,11 +13,11 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import CORPUS, requires_corpus
 from zonegraph.data.b123d import ConvertedDesign, CorpusEntry, convert_batch, convert_design, list_corpus
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
+from zonegraph.testing import CORPUS, requires_corpus
 
 STATUSES = {
     "ok",

@@ -11,10 +11,10 @@ import sys
 import pandas as pd
 
 from eval.searches import Search, folder_targets, run_searches
-from tests.conftest import requires_samples
-from tests.mlflow_server import mlflow_server, rest, search_runs
 from training.ranker import SHIPPED
 from zonegraph.configs import InferConfig
+from zonegraph.testing import requires_samples
+from zonegraph.testing.mlflow_server import mlflow_server, rest, search_runs
 
 PARTS = ["Couch.json", "Pattern4-SteppedStartEndFace_17dd857d_0000.json"]
 

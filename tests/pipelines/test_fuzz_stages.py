@@ -10,8 +10,8 @@ import shutil
 import pandas as pd
 import yaml
 
-from bench.fuzz import mutated_designs
-from tests.pipelines.test_stages import run_stage
+from zonegraph.testing.fuzz import mutated_designs
+from zonegraph.testing.stages import run_stage
 
 GOOD = ("SingleSketchExtrude", "Couch", "Hexagon")
 MUTATED, SEED = 24, 0

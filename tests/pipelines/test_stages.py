@@ -3,20 +3,12 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import pandas as pd
 import pyarrow.dataset as ds
 import yaml
 
-
-def run_stage(module: str, cwd) -> str:
-    proc = subprocess.run(
-        [sys.executable, "-m", module], cwd=cwd, capture_output=True, text=True, timeout=600
-    )
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return proc.stdout
+from zonegraph.testing.stages import run_stage
 
 
 def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):

@@ -12,8 +12,6 @@ from torch_geometric.loader import DataLoader
 
 from eval.heldout import held_out, trained_projects
 from pipelines.ablations import train_variant, variants
-from tests.conftest import gt_rows, requires_samples
-from tests.mlflow_server import mlflow_server, search_runs
 from training.card import card
 from training.data import LabelDataset, geometry_of, state_data
 from training.loss import focal_loss
@@ -27,6 +25,8 @@ from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker, relative_rank
+from zonegraph.testing import gt_rows, requires_samples
+from zonegraph.testing.mlflow_server import mlflow_server, search_runs
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.storage import save_zone_graph
 
