@@ -223,7 +223,7 @@ def _get(node: Any, path: tuple) -> Any:
 
 def spread(items: Sequence[T], salt: str = "") -> st.SearchStrategy[T]:
     """One of ``items``, close to uniformly. ``sampled_from`` draws its first item far more often
-    (Hypothesis's simplest choice: 10 of 24 extent replacements were NaN in a 300-input run), so
+    (Hypothesis's simplest choice; ``docs/results/evidence.md`` has a run where it dominated), so
     the index is a wide integer, offset by a hash of ``salt`` (the design), modulo the length."""
     offset = zlib.crc32(salt.encode())
     return st.integers(0, 2**20).map(lambda i: items[(i + offset) % len(items)])
