@@ -15,13 +15,15 @@ from pathlib import Path
 
 import pytest
 
-from zonegraph.testing.fuzz import SAMPLES, SKIP_REASON, VIOLATIONS, Row, classify
+from zonegraph.testing import requires_samples
+from zonegraph.testing.fuzz import VIOLATIONS, Row, classify
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUTS, SEED, TIMEOUT_S = 100, 0, 10
 
 
-@pytest.mark.skipif(not SAMPLES.is_dir(), reason=SKIP_REASON)
+@pytest.mark.slow
+@requires_samples
 def test_fuzz_slice_keeps_the_cli_contract(tmp_path):
     argv = ["--inputs", str(INPUTS), "--seed", str(SEED), "--timeout", str(TIMEOUT_S), "--out", str(tmp_path)]
     proc = subprocess.run(

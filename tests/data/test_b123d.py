@@ -172,6 +172,7 @@ def _convert(entry: CorpusEntry) -> ConvertedDesign:
     return convert_design(entry.batch, entry.design_id, entry.fusion_volume, entry.fusion_area, timeout_s=120)
 
 
+@pytest.mark.slow
 @requires_corpus
 def test_a_stratified_sample_of_240_converts_and_verifies() -> None:
     entries = list_corpus(CORPUS)

@@ -6,9 +6,12 @@ import json
 
 import pandas as pd
 import pyarrow.dataset as ds
+import pytest
 import yaml
 
 from zonegraph.testing.stages import run_stage
+
+pytestmark = pytest.mark.slow  # a pipeline run, stage by stage, in fresh interpreters
 
 
 def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):

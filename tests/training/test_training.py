@@ -93,6 +93,7 @@ def test_both_fusions_score_and_eval_scores_do_not_depend_on_the_batch(labelled)
         assert torch.allclose(together[0], alone[0], atol=1e-5)
 
 
+@pytest.mark.slow
 @requires_samples
 def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_path, monkeypatch, samples_dir):
     monkeypatch.chdir(tmp_path)
