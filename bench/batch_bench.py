@@ -24,9 +24,9 @@ from collections import Counter
 from pathlib import Path
 
 from zonegraph.batch import PART_SUFFIXES
+from zonegraph.testing import SAMPLES
 
 ROOT = Path(__file__).resolve().parents[1]
-SAMPLES = ROOT.parent / "shared" / "data" / "fusion360_samples"
 
 
 def stage_parts(source: Path, count: int, folder: Path) -> list[Path]:

@@ -8,7 +8,9 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
-CORPUS = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_b123d"
+from zonegraph.testing import CORPUS
+
+__all__ = ["CORPUS", "require_corpus", "run_designs", "write_results"]
 
 
 def require_corpus(path: Path) -> None:

@@ -23,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
-from bench.fuzz import GOOD, OUTCOMES, SAMPLES, SKIP_REASON, VIOLATIONS, Row, fuzz
+from zonegraph.testing.fuzz import GOOD, OUTCOMES, SAMPLES, SKIP_REASON, VIOLATIONS, Row, fuzz
 
 
 def progress(every: int, t0: float) -> Callable[[int, int, list[Row]], None]:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -18,8 +17,7 @@ from zonegraph.data.design import Design, load_design
 from zonegraph.data.replay import replay
 from zonegraph.data.stats import design_statistics, format_comparison
 from zonegraph.data.synthetic import synthetic_design
-
-SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
+from zonegraph.testing import SAMPLES
 
 
 def time_replays(designs: list[Design]) -> tuple[np.ndarray, np.ndarray, list[tuple[float, str, int]]]:

@@ -9,7 +9,6 @@ Runs the search on the simplified zone graph of each real sample and of N synthe
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import numpy as np
 
@@ -20,9 +19,8 @@ from zonegraph.errors import ZoneGraphError
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
+from zonegraph.testing import SAMPLES
 from zonegraph.zones.build import build_zone_graph
-
-SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 
 
 def run(name: str, designs, budget: float, guide: str, max_zones: int) -> None:

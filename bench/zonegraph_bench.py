@@ -19,9 +19,8 @@ from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.data.synthetic import synthetic_design
 from zonegraph.isolation import Outcome, run_isolated
+from zonegraph.testing import SAMPLES
 from zonegraph.zones.build import build_zone_graph
-
-SAMPLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "fusion360_samples"
 
 
 def _build(source: str, simplify: bool) -> dict:

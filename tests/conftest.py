@@ -1,5 +1,5 @@
-"""Shared fixtures: the real Fusion 360 Gallery samples and the build123d script corpus from ../shared
-(skipped when absent)."""
+"""Shared fixtures. The data locations, skip markers and helpers the tests import live in
+:mod:`zonegraph.testing`: a test module never imports this file or another test module."""
 
 from __future__ import annotations
 
@@ -7,38 +7,12 @@ from pathlib import Path
 
 import pytest
 
-SAMPLES = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "fusion360_samples"
-SKIP_REASON = f"real Fusion 360 Gallery samples not found at {SAMPLES} (clone with ../shared beside the repo)"
-
-
-def sample_paths() -> list[Path]:
-    return sorted(SAMPLES.glob("*.json")) if SAMPLES.is_dir() else []
+from zonegraph.testing import SAMPLES, SKIP_REASON
 
 
 @pytest.fixture(scope="session")
 def samples_dir() -> Path:
+    """The real Fusion 360 Gallery samples (the test is skipped when they are absent)."""
     if not SAMPLES.is_dir():
         pytest.skip(SKIP_REASON)
     return SAMPLES
-
-
-requires_samples = pytest.mark.skipif(not SAMPLES.is_dir(), reason=SKIP_REASON)
-
-CORPUS = SAMPLES.parent / "fusion360_b123d"
-CORPUS_SKIP_REASON = f"build123d script corpus not found at {CORPUS} (clone with ../shared beside the repo)"
-requires_corpus = pytest.mark.skipif(not CORPUS.is_dir(), reason=CORPUS_SKIP_REASON)
-
-
-def gt_rows(steps, level: int = 1) -> list[dict]:
-    """The ground-truth stage's per-step rows (what the labels stage reads) of ``GTStep`` objects."""
-    import numpy as np
-
-    return [
-        {
-            "operation": s.operation,
-            "gt_zones": np.flatnonzero(s.zones).tolist(),
-            "captured": s.captured[level],
-            "reason": s.reason,
-        }
-        for s in steps
-    ]

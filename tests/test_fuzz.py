@@ -1,9 +1,9 @@
 """Issue 14's fast fuzz slice: 100 mutated real inputs through ``zonegraph replay|build|infer``.
 
 Every input must end in success, a one-line user error (exit 2) or a timeout: no hang, traceback,
-noise or partial output (``bench/fuzz.py`` defines the inputs and the classes). The harness runs in
-a fresh interpreter: it forks a child per input, and this pytest process may already have run
-OpenCASCADE Booleans, after which a forked child can hang.
+noise or partial output (``zonegraph/testing/fuzz.py`` defines the inputs and the classes). The
+harness runs in a fresh interpreter: it forks a child per input, and this pytest process may
+already have run OpenCASCADE Booleans, after which a forked child can hang.
 """
 
 from __future__ import annotations
@@ -15,13 +15,15 @@ from pathlib import Path
 
 import pytest
 
-from bench.fuzz import SAMPLES, SKIP_REASON, VIOLATIONS, Row, classify
+from zonegraph.testing import requires_samples
+from zonegraph.testing.fuzz import VIOLATIONS, Row, classify
 
 ROOT = Path(__file__).resolve().parents[1]
 INPUTS, SEED, TIMEOUT_S = 100, 0, 10
 
 
-@pytest.mark.skipif(not SAMPLES.is_dir(), reason=SKIP_REASON)
+@pytest.mark.slow
+@requires_samples
 def test_fuzz_slice_keeps_the_cli_contract(tmp_path):
     argv = ["--inputs", str(INPUTS), "--seed", str(SEED), "--timeout", str(TIMEOUT_S), "--out", str(tmp_path)]
     proc = subprocess.run(

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import requires_samples, sample_paths
 from zonegraph.configs import InferConfig
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import as_shape, replay
@@ -19,6 +18,7 @@ from zonegraph.data.targets import load_target
 from zonegraph.geometry.shapes import read_solids, write_brep
 from zonegraph.reconstruction import infer
 from zonegraph.sequence.program import brep_iou
+from zonegraph.testing import requires_samples, sample_paths
 
 DISTINCT = [p for p in sample_paths() if not p.stem.startswith(("SingleSketchExtrude_", "Z0HexagonCutJoin"))]
 SCRIPT = Path(sys.executable).parent / "zonegraph"

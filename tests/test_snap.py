@@ -17,7 +17,6 @@ from pathlib import Path
 import pytest
 from build123d import Unit
 
-from tests.conftest import CORPUS, requires_corpus, requires_samples
 from zonegraph.configs import InferConfig
 from zonegraph.data.replay import as_shape
 from zonegraph.data.targets import load_target
@@ -26,6 +25,7 @@ from zonegraph.export.verify import export_texts, verified_export
 from zonegraph.geometry.shapes import read_solids
 from zonegraph.reconstruction import EXACT_IOU, infer, reconstruct
 from zonegraph.sequence.program import ProgramStep, brep_iou, build_program, execute
+from zonegraph.testing import CORPUS, requires_corpus, requires_samples
 
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e-?\d+)?")
 NOISY_CORPUS_DESIGN = ("01_2ops/batch_001.py", "100798_1efa7e4b_0000")  # 3.49999999979 for 3.5

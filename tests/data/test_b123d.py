@@ -13,11 +13,11 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import CORPUS, requires_corpus
 from zonegraph.data.b123d import ConvertedDesign, CorpusEntry, convert_batch, convert_design, list_corpus
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
+from zonegraph.testing import CORPUS, requires_corpus
 
 STATUSES = {
     "ok",
@@ -172,6 +172,7 @@ def _convert(entry: CorpusEntry) -> ConvertedDesign:
     return convert_design(entry.batch, entry.design_id, entry.fusion_volume, entry.fusion_area, timeout_s=120)
 
 
+@pytest.mark.slow
 @requires_corpus
 def test_a_stratified_sample_of_240_converts_and_verifies() -> None:
     entries = list_corpus(CORPUS)

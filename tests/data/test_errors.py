@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import pytest
 
-from tests import fusion_json as fj
 from zonegraph.cli import main
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError
+from zonegraph.testing import fusion_json as fj
 
 
 def replay_file(path):

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from tests import fusion_json as fj
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
+from zonegraph.testing import fusion_json as fj
 
 SQUARE = [(True, fj.rect(0, 0, 2, 2))]  # area 4
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from tests.conftest import requires_samples, sample_paths
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.geometry.shapes import read_solids, symmetric_difference_volume
+from zonegraph.testing import requires_samples, sample_paths
 
 RTOL = 1e-6
 

@@ -7,12 +7,12 @@ import pandas as pd
 import pytest
 
 from eval.rank import bootstrap_mean, guide_ranks, make_guides, rank_states, summarise
-from tests.conftest import gt_rows, requires_samples
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.jobs import label_and_save
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.rankers import HeuristicRanker
+from zonegraph.testing import gt_rows, requires_samples
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.storage import save_zone_graph
 

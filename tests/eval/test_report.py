@@ -9,12 +9,15 @@ import subprocess
 import sys
 
 import pandas as pd
+import pytest
 
 from eval.searches import Search, folder_targets, run_searches
-from tests.conftest import requires_samples
-from tests.mlflow_server import mlflow_server, rest, search_runs
 from zonegraph.configs import InferConfig
 from zonegraph.network.checkpoint import SHIPPED
+from zonegraph.testing import requires_samples
+from zonegraph.testing.mlflow_server import mlflow_server, rest, search_runs
+
+pytestmark = pytest.mark.slow  # each test runs searches on real parts and an MLflow server
 
 PARTS = ["Couch.json", "Pattern4-SteppedStartEndFace_17dd857d_0000.json"]
 

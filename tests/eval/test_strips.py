@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from eval.strips import design_strip
-from tests.conftest import requires_samples
 from zonegraph.export.render import render_strips
+from zonegraph.testing import requires_samples
 
 
 @requires_samples

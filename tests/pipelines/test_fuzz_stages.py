@@ -8,10 +8,13 @@ from __future__ import annotations
 import shutil
 
 import pandas as pd
+import pytest
 import yaml
 
-from bench.fuzz import mutated_designs
-from tests.pipelines.test_stages import run_stage
+from zonegraph.testing.fuzz import mutated_designs
+from zonegraph.testing.stages import run_stage
+
+pytestmark = pytest.mark.slow  # a pipeline run, stage by stage, in fresh interpreters
 
 GOOD = ("SingleSketchExtrude", "Couch", "Hexagon")
 MUTATED, SEED = 24, 0

@@ -3,34 +3,15 @@
 from __future__ import annotations
 
 import json
-import os
-import shlex
-import subprocess
-import sys
 
 import pandas as pd
 import pyarrow.dataset as ds
+import pytest
 import yaml
 
-from pipelines.runner import PROJECT
+from zonegraph.testing.stages import run_stage
 
-
-def run_stage(module: str, cwd) -> str:
-    """Run the stage of ``dvc.yaml`` whose command runs ``module``, with that command's paths."""
-    stages = yaml.safe_load((PROJECT / "dvc.yaml").read_text())["stages"]
-    commands = [shlex.split(s["cmd"]) for s in stages.values()]
-    words = next(c for c in commands if c[:3] == ["python", "-m", module])
-    path = os.pathsep.join(p for p in (str(PROJECT), os.environ.get("PYTHONPATH")) if p)
-    proc = subprocess.run(  # the stage scripts are the checkout's, not installed
-        [sys.executable, *words[1:]],
-        cwd=cwd,
-        capture_output=True,
-        text=True,
-        timeout=600,
-        env={**os.environ, "PYTHONPATH": path},
-    )
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return proc.stdout
+pytestmark = pytest.mark.slow  # a pipeline run, stage by stage, in fresh interpreters
 
 
 def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):

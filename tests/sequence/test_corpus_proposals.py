@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tests.corpus import corpus_shape, requires_corpus
 from zonegraph.sequence.proposals import ProposalGenerator
+from zonegraph.testing import requires_corpus
+from zonegraph.testing.corpus import corpus_shape
 from zonegraph.zones.build import build_zone_graph
 
 pytestmark = requires_corpus

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from build123d import Box, Cylinder
 
-from tests.conftest import requires_samples, sample_paths
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.sequence.ground_truth import MAPPING_RTOL, ground_truth, map_tool
+from zonegraph.testing import requires_samples, sample_paths
 from zonegraph.zones.build import build_zone_graph
 
 

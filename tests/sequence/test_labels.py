@@ -8,7 +8,6 @@ import pyarrow.parquet as pq
 import pytest
 from build123d import Box, Cylinder, Pos
 
-from tests.conftest import gt_rows, requires_samples
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.jobs import label_and_save
@@ -24,6 +23,7 @@ from zonegraph.sequence.labels import (
     label_design,
     label_tables,
 )
+from zonegraph.testing import gt_rows, requires_samples
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.storage import save_zone_graph
 

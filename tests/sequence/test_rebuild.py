@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import pytest
 
-from tests.corpus import corpus_shape, requires_corpus
 from zonegraph.configs import InferConfig
 from zonegraph.data.replay import as_shape
 from zonegraph.geometry.shapes import write_brep
@@ -13,6 +12,8 @@ from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.program import brep_iou, build_program, execute
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import HeuristicRanker
+from zonegraph.testing import requires_corpus
+from zonegraph.testing.corpus import corpus_shape
 from zonegraph.zones.build import build_zone_graph
 
 pytestmark = requires_corpus

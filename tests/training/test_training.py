@@ -12,8 +12,6 @@ from torch_geometric.loader import DataLoader
 
 from eval.heldout import held_out, trained_projects
 from pipelines.ablations import train_variant, variants
-from tests.conftest import gt_rows, requires_samples
-from tests.mlflow_server import mlflow_server, search_runs
 from training.card import card
 from training.data import LabelDataset
 from training.loss import focal_loss
@@ -29,6 +27,8 @@ from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker, relative_rank
+from zonegraph.testing import gt_rows, requires_samples
+from zonegraph.testing.mlflow_server import mlflow_server, search_runs
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.storage import save_zone_graph
 
@@ -95,6 +95,7 @@ def test_both_fusions_score_and_eval_scores_do_not_depend_on_the_batch(labelled)
         assert torch.allclose(together[0], alone[0], atol=1e-5)
 
 
+@pytest.mark.slow
 @requires_samples
 def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_path, monkeypatch, samples_dir):
     monkeypatch.chdir(tmp_path)

@@ -9,12 +9,12 @@ from OCP.BRepClass3d import BRepClass3d_SolidClassifier
 from OCP.TopAbs import TopAbs_FACE, TopAbs_IN
 from OCP.TopoDS import TopoDS
 
-from tests.conftest import requires_samples, sample_paths
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.geometry.cells import fuse_zones
 from zonegraph.geometry.occ import pnt, sub_shapes
 from zonegraph.geometry.shapes import symmetric_difference_volume
+from zonegraph.testing import requires_samples, sample_paths
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.face_loops import find_face_loops
 

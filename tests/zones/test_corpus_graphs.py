@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from tests.corpus import corpus_shape, requires_corpus
+from zonegraph.testing import requires_corpus
+from zonegraph.testing.corpus import corpus_shape
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import BOX_VOLUME_RTOL, MESH_BOX_RTOL
 

@@ -36,9 +36,9 @@ def select_cells(
 
     One fuse of every operand at once evaluates any Boolean expression of them: it does not
     depend on a chain of Booleans, each of which may fail on the result of the one before.
-    Unifying same-domain faces broke every valid result of ``41125_711db4bf_0002``'s tools (and,
-    working in place, the raw result too), so a copy is unified and kept only when the checker
-    accepts it or rejects the raw result as well.
+    Unifying same-domain faces can break a valid result (and, working in place, the raw result
+    too; a measured case: ``docs/results/evidence.md``), so a copy is unified and kept only when
+    the checker accepts it or rejects the raw result as well.
 
     Raises:
         RuntimeError: the general fuse reported errors.

@@ -112,9 +112,10 @@ def execute(program: list[ProgramStep]) -> list[Shape | None]:
     makes every later Boolean, and the final IoU, come back empty or wrong: each step keeps the
     first valid result of the alternatives in :func:`_combine`, else of one general fuse of every
     tool so far (:func:`_cells_rebuild`), else the first result it has. Once a step came from the
-    cells, later steps do too where they can: a union of ``41125_711db4bf_0002`` run on such a
-    part (fuzzy, tolerances 3e-5) came back valid with a vertex tolerance of 0.2 (4% of the
-    part), and no common with the target then held more than 3% of it."""
+    cells, later steps do too where they can: a Boolean run on such a part (fuzzy, loose
+    tolerances) can come back valid yet with a vertex tolerance of a few percent of the part,
+    after which no common with the target holds more than a sliver of it (the measured case:
+    ``docs/results/evidence.md``)."""
     shape: Shape | None = None
     states = []
     tools: list[Shape] = []
@@ -162,9 +163,9 @@ FUZZY_SHARES = (0.0, 1e-7, 1e-5)
 def _combine(shape: Shape, tool: Shape, op: Op) -> Shape | None:
     """``shape`` fused with or cut by ``tool``, trying in turn: the operands as they are, the tool
     repaired, fuzzy values, and the part so far repaired. The first result the checker accepts
-    wins, else the first result as it came: an invalid part often still takes the next Booleans
-    (repairing one in place broke the next union of ``130022_505982e4_0000``). None when every
-    Boolean failed."""
+    wins, else the first result as it came: an invalid part often still takes the next Booleans,
+    while repairing one in place can break the next union (``docs/results/evidence.md``). None
+    when every Boolean failed."""
     diag = float(shape.bounding_box().diagonal)
     first = None
     for x, y, share in _alternatives(shape, tool):
@@ -180,10 +181,10 @@ def _cells_rebuild(ops: list[Op], tools: list[Shape], diag: float) -> Shape | No
     """The program ``ops`` evaluated on the cells of one general fuse of its ``tools`` (at the
     fuzzy values of ``FUZZY_SHARES``): a cell is kept when the last step whose tool contains it is
     a union. It does not depend on the part so far, which earlier invalid Booleans may have made
-    wrong: on the corpus, ``41125_711db4bf_0002``'s sixth step (a cut) came back invalid with a
-    third of the part's volume, and ``23325_292b3294_0000``'s ninth (a union) failed outright;
-    their cells rebuilt both to B-rep IoU above 1 - 2e-8, in 0.2 to 0.3 s per fuse. The first result
-    the checker accepts wins, else the first with volume; None when every fuse failed."""
+    wrong (a cut that comes back invalid with part of the volume, a union that fails outright):
+    the cells rebuild such parts exactly, in a fraction of a second per fuse on corpus parts
+    (the measured cases: ``docs/results/evidence.md``). The first result the checker accepts
+    wins, else the first with volume; None when every fuse failed."""
     first = None
     for share in FUZZY_SHARES:
         try:
@@ -292,10 +293,10 @@ def _tightened(shape: Shape) -> Shape:
     """A copy of ``shape`` with every tolerance limited to OpenCASCADE's confusion (1e-7).
 
     The program's sketches are partition faces of the zone graph's fuzzy fuse, whose tolerances
-    (up to 1e-6 of the normalised part) its Booleans pass on to the rebuilt part: ``128645_d5cdd476_0002``
-    rebuilt with vertex tolerances of 6e-3, which swallowed the target's 2e-6 steps in its
-    bottom face, and every common kept 2e-4 of the part; limited to 1e-7 (1e-6 still failed) the
-    same part, still valid, measured IoU 1 - 3e-9."""
+    (up to 1e-6 of the normalised part) its Booleans pass on to the rebuilt part, where they can
+    grow until they swallow the target's small steps and every common with the target loses
+    part of the volume; limited to 1e-7 (1e-6 is not always enough) such a part, still valid,
+    measures its true IoU (the measured case: ``docs/results/evidence.md``)."""
     copy = BRepBuilderAPI_Copy(shape.wrapped).Shape()
     ShapeFix_ShapeTolerance().LimitTolerance(copy, 0.0, Precision.Confusion_s(), TopAbs_SHAPE)
     return Shape.cast(copy)

@@ -303,9 +303,9 @@ def _partition(
 
 def _mesh_volume_ratios(graph: ZoneGraph, mesh: _ZoneMesh, target_volume: float, solids: list) -> dict:
     """Zone volumes measured a second way, where the exact integrals disagree with the box or the
-    target: OpenCASCADE integrates surfaces of extrusion and B-splines to only ~1e-4 (the target of
-    ``132996_c742ef84_0005`` measured 0.990 to 1.007 of itself at precisions 1e-4, 1e-6 and 1e-8),
-    behind most of the 83 graphs of 3,578 refused as ``fuse_failed`` in a 3,600-design run.
+    target: OpenCASCADE integrates surfaces of extrusion and B-splines to only ~1e-4, and at
+    several precisions a free-form target can measure a percent off itself, which otherwise
+    refuses good graphs as ``fuse_failed`` (the measured cases: ``docs/results/evidence.md``).
     Meshed in one pass, neighbouring zones share their face triangles, so the zone meshes tile
     the box exactly; the target is meshed on its own at the same deflection, and only where it
     has free-form faces (planes and cylinders integrate exactly: a deficit there is real)."""
@@ -521,7 +521,7 @@ class _ZoneMesh:
     def _mesh_confirmed(self, z: int, size: float, tries: int) -> np.ndarray:
         """A candidate confirmed by the parity of a ray's crossings with the zone's own mesh: the
         solid classifier says OUT everywhere in some zones the volume maker builds at a tangent
-        cylinder (2,000 random points in one's box, 45% of which it fills, all OUT)."""
+        cylinder, even at points well inside them (``docs/results/evidence.md``)."""
         c, n, area = self.zone_tris[z]
         for p in self._candidates(self.topo.zone_centroid[z], c, n, area, size, tries):
             if _inside_mesh(p, c):

@@ -9,12 +9,12 @@ import functools
 
 from build123d import Shape
 
-from tests.conftest import CORPUS, requires_corpus
 from zonegraph.data.b123d import convert_design
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
+from zonegraph.testing.locations import CORPUS
 
-__all__ = ["corpus_shape", "requires_corpus"]
+__all__ = ["corpus_shape"]
 
 
 @functools.cache

@@ -1,29 +1,42 @@
-"""Hand-written Fusion-format JSON fixtures, independent of zonegraph's own serializer."""
+"""Hand-written Fusion-format JSON fixtures, independent of zonegraph's own serializer.
+
+The replay and error tests build their designs from these, so a bug in zonegraph's Fusion JSON
+writer cannot hide the same bug in its reader."""
 
 from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
-XY = {"origin": (0, 0, 0), "x_axis": (1, 0, 0), "y_axis": (0, 1, 0), "z_axis": (0, 0, 1)}
+Json = dict[str, Any]
+XYZ = Sequence[float]
+
+Frame = dict[str, tuple[float, float, float]]
+
+XY: Frame = {"origin": (0, 0, 0), "x_axis": (1, 0, 0), "y_axis": (0, 1, 0), "z_axis": (0, 0, 1)}
 
 
-def pt(x, y, z=0.0):
+def pt(x: float, y: float, z: float = 0.0) -> Json:
     return {"type": "Point3D", "x": x, "y": y, "z": z}
 
 
-def vec(x, y, z):
+def vec(x: float, y: float, z: float) -> Json:
     return {"type": "Vector3D", "x": x, "y": y, "z": z, "length": math.sqrt(x * x + y * y + z * z)}
 
 
-def line(a, b):
+def line(a: XYZ, b: XYZ) -> Json:
     return {"type": "Line3D", "start_point": pt(*a), "end_point": pt(*b)}
 
 
-def arc(c, r, a0, a1):
+def arc(c: XYZ, r: float, a0: float, a1: float) -> Json:
     """Counter-clockwise arc about +z from angle a0 to a1 (reference vector +x)."""
-    p = lambda t: (c[0] + r * math.cos(t), c[1] + r * math.sin(t))  # noqa: E731
+
+    def p(t: float) -> tuple[float, float]:
+        return c[0] + r * math.cos(t), c[1] + r * math.sin(t)
+
     return {
         "type": "Arc3D",
         "start_point": pt(*p(a0)),
@@ -37,11 +50,11 @@ def arc(c, r, a0, a1):
     }
 
 
-def circle(c, r):
+def circle(c: XYZ, r: float) -> Json:
     return {"type": "Circle3D", "center_point": pt(*c), "radius": r, "normal": vec(0, 0, 1)}
 
 
-def ellipse(c, a, b):
+def ellipse(c: XYZ, a: float, b: float) -> Json:
     return {
         "type": "Ellipse3D",
         "center_point": pt(*c),
@@ -52,7 +65,7 @@ def ellipse(c, a, b):
     }
 
 
-def nurbs(points, degree, knots):
+def nurbs(points: Sequence[XYZ], degree: int, knots: Sequence[float]) -> Json:
     return {
         "type": "NurbsCurve3D",
         "degree": degree,
@@ -64,12 +77,12 @@ def nurbs(points, degree, knots):
     }
 
 
-def rect(x0, y0, x1, y1):
+def rect(x0: float, y0: float, x1: float, y1: float) -> list[Json]:
     c = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
     return [line(c[i], c[(i + 1) % 4]) for i in range(4)]
 
 
-def sketch(loops, frame=XY, name="Sketch1"):
+def sketch(loops: Sequence[tuple[bool, list[Json]]], frame: Frame = XY, name: str = "Sketch1") -> Json:
     """``loops``: a list of (is_outer, curves); one profile named 'p'."""
     return {
         "type": "Sketch",
@@ -79,23 +92,27 @@ def sketch(loops, frame=XY, name="Sketch1"):
     }
 
 
-def extent(d, taper=0.0, full=None):
-    out = {"type": "DistanceExtentDefinition", "distance": {"value": d}, "taper_angle": {"value": taper}}
+def extent(d: float, taper: float = 0.0, full: bool | None = None) -> Json:
+    out: Json = {
+        "type": "DistanceExtentDefinition",
+        "distance": {"value": d},
+        "taper_angle": {"value": taper},
+    }
     if full is not None:
         out["is_full_length"] = full
     return out
 
 
 def extrude(
-    sketch_id,
-    op="NewBodyFeatureOperation",
-    kind="OneSideFeatureExtentType",
-    one=None,
-    two=None,
-    offset=None,
-    profile="p",
-):
-    e = {
+    sketch_id: str,
+    op: str = "NewBodyFeatureOperation",
+    kind: str = "OneSideFeatureExtentType",
+    one: Json | None = None,
+    two: Json | None = None,
+    offset: float | None = None,
+    profile: str = "p",
+) -> Json:
+    e: Json = {
         "type": "ExtrudeFeature",
         "name": "Extrude",
         "operation": op,
@@ -113,7 +130,7 @@ def extrude(
     return e
 
 
-def design(*entities) -> dict:
+def design(*entities: Json) -> Json:
     """Entities in timeline order; ids are s0/e1/... by position."""
     ents = {}
     for i, e in enumerate(entities):
@@ -121,7 +138,7 @@ def design(*entities) -> dict:
     return {"timeline": [{"index": i, "entity": k} for i, k in enumerate(ents)], "entities": ents}
 
 
-def write(tmp_path: Path, data: dict, name: str = "fixture") -> Path:
+def write(tmp_path: Path, data: Json, name: str = "fixture") -> Path:
     path = tmp_path / f"{name}.json"
     path.write_text(json.dumps(data))
     return path

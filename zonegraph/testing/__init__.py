@@ -1,0 +1,65 @@
+"""Test support shipped with the package (as ``torch_geometric.testing`` is with PyG).
+
+What the tests and the benchmarks share, defined once:
+
+- :mod:`zonegraph.testing.locations`: where the real samples and the corpus are
+  (``SAMPLES``, ``CORPUS``, :func:`sample_paths`), looked for beside the checkout;
+- ``requires_samples`` / ``requires_corpus``: pytest skip markers, from
+  :mod:`zonegraph.testing.markers`, loaded on first use: pytest is in the ``test`` extra, and this
+  package must stay importable without it (the benchmarks read the locations);
+- :func:`gt_rows`: the ground-truth stage's rows of in-memory ``GTStep`` objects;
+- :mod:`zonegraph.testing.fuzz`: the fuzz harness (mutated real inputs through the CLI, each run
+  classified), shared by ``bench/fuzz_bench.py`` and the fuzz tests (needs hypothesis);
+- :mod:`zonegraph.testing.corpus` (real corpus designs replayed),
+  :mod:`zonegraph.testing.fusion_json` (hand-written design JSON),
+  :mod:`zonegraph.testing.mlflow_server` (a real tracking server) and
+  :mod:`zonegraph.testing.stages` (a pipeline stage in a fresh interpreter).
+
+Nothing below :mod:`zonegraph.testing` imports it: it is a top layer.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from zonegraph.testing.locations import (
+    CORPUS,
+    CORPUS_SKIP_REASON,
+    SAMPLES,
+    SKIP_REASON,
+    corpus_root,
+    sample_paths,
+    samples_root,
+    shared_root,
+)
+
+_LAZY = {
+    "requires_samples": "zonegraph.testing.markers",
+    "requires_corpus": "zonegraph.testing.markers",
+    "gt_rows": "zonegraph.testing.ground_truth",
+}
+
+__all__ = [
+    "CORPUS",
+    "CORPUS_SKIP_REASON",
+    "SAMPLES",
+    "SKIP_REASON",
+    "corpus_root",
+    "gt_rows",
+    "requires_corpus",
+    "requires_samples",
+    "sample_paths",
+    "samples_root",
+    "shared_root",
+]
+
+if TYPE_CHECKING:
+    from zonegraph.testing.ground_truth import gt_rows
+    from zonegraph.testing.markers import requires_corpus, requires_samples
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'zonegraph.testing' has no attribute {name!r}")
