@@ -27,7 +27,7 @@ from zonegraph.data.stats import design_statistics, format_comparison, timeline_
 from zonegraph.data.synthetic import design_seed, generate_design, synthetic_id
 
 from .cluster import dask_client
-from .params import load_params
+from .params import PARAMS_FILE, DaskParams, DataParams, SyntheticParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/designs")
@@ -59,7 +59,7 @@ def convert_to_json(batch: str, design_id: str, path: str, timeout_s: float) -> 
     }
 
 
-def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
+def generate(count: int, seed: int, dask_cfg: DaskParams, timeout: float) -> Path:
     json_dir = OUT / "json"
     json_dir.mkdir(parents=True, exist_ok=True)
     code = code_fingerprint("generate")
@@ -76,7 +76,9 @@ def generate(count: int, seed: int, dask_cfg: dict, timeout: float) -> Path:
     return json_dir
 
 
-def convert_corpus(root: Path, limit: int | None, seed: int, dask_cfg: dict, timeout: float) -> pd.DataFrame:
+def convert_corpus(
+    root: Path, limit: int | None, seed: int, dask_cfg: DaskParams, timeout: float
+) -> pd.DataFrame:
     """Convert (a stratified sample of) the corpus; returns one row per design, failures included."""
     entries = list_corpus(root)
     entries = [entries[i] for i in stratified_sample([e.folder for e in entries], limit, seed)]
@@ -130,27 +132,19 @@ def write_conversion(table: pd.DataFrame) -> None:
 
 
 def main() -> None:
-    params = load_params()
-    data = params["data"]
-    source = data.get("source", "synthetic")
-    limit = data.get("limit")
-    seed, fraction = int(data["split_seed"]), float(data["test_fraction"])
+    data, dask = section(DataParams, "data"), section(DaskParams, "dask")
+    source, limit = data.source, data.limit
+    seed, fraction = data.split_seed, data.test_fraction
     if source == "fusion_json":
-        folder = Path(data["fusion_json_dir"]).expanduser().resolve()
+        folder = Path(_folder(data.fusion_json_dir, "fusion_json_dir")).expanduser().resolve()
     elif source == "b123d":
-        root = Path(data["b123d_dir"]).expanduser().resolve()
-        table = convert_corpus(
-            root,
-            limit,
-            int(data.get("limit_seed", 0)),
-            params["dask"],
-            float(data.get("convert_timeout_s", 120)),
-        )
+        root = Path(_folder(data.b123d_dir, "b123d_dir")).expanduser().resolve()
+        table = convert_corpus(root, limit, data.limit_seed, dask, data.convert_timeout_s)
         write_conversion(table)
         folder = OUT / "json"
     elif source == "synthetic":
-        syn = params["synthetic"]
-        folder = generate(int(syn["count"]), int(syn["seed"]), params["dask"], float(syn["timeout_s"]))
+        syn = section(SyntheticParams, "synthetic")
+        folder = generate(syn.count, syn.seed, dask, syn.timeout_s)
     else:
         raise SystemExit(f"generate: unknown data.source {source!r} (synthetic, fusion_json or b123d)")
     if source == "b123d":  # this run's converted designs (the folder may hold earlier runs' too)
@@ -166,6 +160,12 @@ def main() -> None:
         METRICS.parent.mkdir(parents=True, exist_ok=True)
         METRICS.write_text(json.dumps({"source": source, "designs": len(records)}, indent=2))
     print(f"generate: {len(records)} designs from {folder} ({source})")
+
+
+def _folder(value: str | None, key: str) -> str:
+    if value is None:
+        raise SystemExit(f"{PARAMS_FILE}: data: this source needs data.{key}")
+    return value
 
 
 def write_index(records: list[DesignRecord], table: pd.DataFrame | None) -> None:

@@ -22,7 +22,7 @@ from zonegraph.data.dataset import stratified_sample
 from zonegraph.jobs import label_and_save
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, LabelsParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/labels")
@@ -48,24 +48,23 @@ def candidates(designs: pd.DataFrame, splits: list[str], limit: int | None, seed
 
 
 def main() -> None:
-    params = load_params()
-    cfg = params["labels"]
-    level, seed = int(cfg["level"]), int(cfg["seed"])
-    splits = list(cfg["splits"])
-    rank_splits = [s for s in cfg.get("rank_splits") or [] if s not in splits]
+    cfg = section(LabelsParams, "labels")
+    level, seed = cfg.level, cfg.seed
+    splits = list(cfg.splits)
+    rank_splits = [s for s in cfg.rank_splits if s not in splits]
     designs = pd.read_parquet("data/gt/designs.parquet")
     steps = saved_graph_rows(pd.read_parquet("data/gt/steps.parquet"))
     column = f"captured_l{level}"
     if column not in steps:
         raise SystemExit(f"labels: level {level} is not among ground_truth.levels ({column} missing)")
-    limit, limit_seed = cfg.get("limit"), int(cfg.get("limit_seed", 0))
+    limit, limit_seed = cfg.limit, cfg.limit_seed
     todo = pd.concat(
         [candidates(designs, splits, limit, limit_seed), candidates(designs, rank_splits, limit, limit_seed)]
     )
 
     def settings(split: str) -> tuple[int, int, float, int]:
-        multiplier = 0.0 if split in rank_splits else float(cfg["multiplier"])
-        return seed, level, multiplier, int(cfg["slack"])
+        multiplier = 0.0 if split in rank_splits else cfg.multiplier
+        return seed, level, multiplier, cfg.slack
 
     gt_of = {
         d: [
@@ -99,8 +98,8 @@ def main() -> None:
         for row in todo.itertuples()
         if row.design_id in gt_of
     ]
-    with dask_client(params["dask"]) as client:
-        records = run_jobs(label_and_save, jobs, OUT / "records", client, float(cfg["timeout_s"]), "labels")
+    with dask_client(section(DaskParams, "dask")) as client:
+        records = run_jobs(label_and_save, jobs, OUT / "records", client, cfg.timeout_s, "labels")
     keep = {r["design_id"] for r in records if r["status"] == "ok"}
     for shard in [*OUT.glob("proposals/*.parquet"), *OUT.glob("steps/*.parquet")]:
         if shard.stem not in keep:  # a failed design or one of an earlier, different run

@@ -11,6 +11,7 @@ stage saved (zone-graph build time is excluded from the budget, as in the paper)
 from __future__ import annotations
 
 import json
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,7 @@ from zonegraph.configs import InferConfig
 from zonegraph.reconstruction import infer
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, ReconstructParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/reconstruct")
@@ -54,16 +55,15 @@ def summarise(results: pd.DataFrame) -> dict:
 
 
 def main() -> None:
-    params = load_params()
-    cfg = params["reconstruct"]
+    cfg = section(ReconstructParams, "reconstruct")
     replayed = pd.read_parquet("data/replay/manifest.parquet")
     test = replayed[(replayed["split"] == "test") & (replayed["status"] == "ok")]
     zones = pd.read_parquet("data/zonegraphs/manifest.parquet").set_index("design_id")["zones"].fillna(0)
     code = code_fingerprint("reconstruct")
     jobs = []
-    for guide in cfg["guides"]:
-        config = InferConfig.from_mapping({**cfg, "guide": guide})
-        model = (cfg["model"],) if guide == "net" and cfg.get("model") else ()  # its weights count too
+    for guide in cfg.guides:
+        config = InferConfig.from_mapping({**asdict(cfg), "guide": guide})
+        model = (cfg.model,) if guide == "net" and cfg.model else ()  # its weights count too
         for row in test.itertuples():
             brep = f"{row.brep_dir}/final.brep"
             graph = Path("data/zonegraphs/graphs") / row.design_id
@@ -75,10 +75,8 @@ def main() -> None:
                     cost=float(zones.get(row.design_id, 0)),
                 )
             )
-    with dask_client(params["dask"]) as client:
-        records = run_jobs(
-            reconstruct_design, jobs, OUT / "records", client, float(cfg["timeout_s"]), "reconstruct"
-        )
+    with dask_client(section(DaskParams, "dask")) as client:
+        records = run_jobs(reconstruct_design, jobs, OUT / "records", client, cfg.timeout_s, "reconstruct")
     results = pd.DataFrame(records).drop(columns=["fingerprint"])
     results[["guide", "design_id"]] = results["design_id"].str.split("__", n=1, expand=True)
     results.to_parquet(OUT / "results.parquet", index=False)

@@ -17,7 +17,7 @@ from zonegraph.data.replay import replay
 from zonegraph.geometry.shapes import write_brep
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, ReplayParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/replay")
@@ -50,7 +50,7 @@ def replay_design(path: str, out_dir: str) -> dict:
 
 
 def main() -> None:
-    params = load_params()
+    cfg = section(ReplayParams, "replay")
     index = pd.read_parquet("data/designs/index.parquet")
     code = code_fingerprint("replay")
     jobs = [
@@ -61,10 +61,8 @@ def main() -> None:
         )
         for row in index.itertuples()
     ]
-    with dask_client(params["dask"]) as client:
-        records = run_jobs(
-            replay_design, jobs, OUT / "records", client, float(params["replay"]["timeout_s"]), "replay"
-        )
+    with dask_client(section(DaskParams, "dask")) as client:
+        records = run_jobs(replay_design, jobs, OUT / "records", client, cfg.timeout_s, "replay")
     manifest = pd.DataFrame(records).drop(columns=["fingerprint"])
     manifest.insert(1, "split", index["split"].to_numpy())
     manifest = manifest.rename(columns={"reason": "error"})

@@ -8,6 +8,7 @@ edges, build seconds, simplified), designs that failed to replay included with t
 from __future__ import annotations
 
 import json
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +18,7 @@ from zonegraph.configs import BuildConfig
 from zonegraph.jobs import build_and_save
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, ZoneGraphParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 OUT = Path("data/zonegraphs")
@@ -25,12 +26,11 @@ METRICS = Path("data/metrics/zonegraphs.json")
 
 
 def main() -> None:
-    params = load_params()
-    cfg = params["zonegraph"]
+    cfg = section(ZoneGraphParams, "zonegraph")
     replayed = pd.read_parquet("data/replay/manifest.parquet")
     ok = replayed[replayed["status"] == "ok"]
     code = code_fingerprint("zonegraphs")
-    config = BuildConfig.from_mapping(cfg)
+    config = BuildConfig.from_mapping(asdict(cfg))  # the section less the stage's timeout
     jobs = [
         Job(
             row.design_id,
@@ -40,10 +40,8 @@ def main() -> None:
         )
         for row in ok.itertuples()
     ]
-    with dask_client(params["dask"]) as client:
-        records = run_jobs(
-            build_and_save, jobs, OUT / "records", client, float(cfg["timeout_s"]), "zonegraphs"
-        )
+    with dask_client(section(DaskParams, "dask")) as client:
+        records = run_jobs(build_and_save, jobs, OUT / "records", client, cfg.timeout_s, "zonegraphs")
     built = pd.DataFrame(records).drop(columns=["fingerprint"])
     skipped = replayed.loc[replayed["status"] != "ok", ["design_id", "status", "error"]].rename(
         columns={"error": "reason"}

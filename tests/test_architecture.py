@@ -12,20 +12,21 @@ import zonegraph
 
 PACKAGE = Path(zonegraph.__file__).parent
 # Each layer may import only layers of a lower rank (and itself); data and zones are siblings.
-# errors, console (capturing native output) and plugins (entry-point groups) import nothing heavy
-# and serve every layer.
+# errors, console (capturing native output), plugins (entry-point groups) and configs (the Config
+# idiom every layer's settings use) import nothing heavy and serve every layer.
 RANK = {
     "errors": 0,
     "console": 0,
     "plugins": 0,
     "status": 0,
+    "configs": 0,
     "geometry": 1,
     "data": 2,
     "zones": 2,
     "sequence": 3,
     "export": 4,
 }
-TOP = 5  # reconstruction, cli, batch, jobs, isolation, outputs, configs and the package root
+TOP = 5  # reconstruction, cli, batch, jobs, isolation, outputs and the package root
 
 
 def _layer(module: str) -> str:
