@@ -26,7 +26,7 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -38,9 +38,53 @@ from eval.programs import program_measures
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
 from eval.strips import pick_designs, write_strips
-from zonegraph.configs import InferConfig
+from zonegraph.configs import Config, ConfigError, InferConfig, load_section
 
 MARKS = (1.0, 5.0, 20.0)  # seconds at which IoU and exact rate are reported as metrics
+
+
+@dataclass(frozen=True)
+class EvalConfig(Config):
+    """The report's settings: its command line's defaults, and the ``evaluate`` section of a
+    ``--params`` file (which overrides them; the command line overrides both).
+
+    Args:
+        model: network checkpoints to evaluate.
+        designs: a split of the project, or a folder of parts.
+        budget_s: search seconds per design and guide.
+        out: the report's folder.
+        k: the search widths of the ablation (heuristic and network); k 5 for every guide.
+        ablation_designs: designs of the k ablation.
+        min_gt_length: IoU vs time on designs with at least this many GT steps (the paper).
+        strips: designs drawn as sequence strips.
+        limit: the first N designs only (None: all).
+        workers: searches side by side.
+        timeout_s: hard stop per search (None: 3 x budget + 60).
+        seed: seed of the random guide and the bootstrap.
+        project: the pipeline project to read data/ from.
+        labels: the labels stage's folder.
+        graphs: the zonegraphs stage's graphs.
+        metrics: also write the metrics JSON here (the DVC metrics file).
+        plot_csv: also write mean IoU vs time (k 5) here, wide (the DVC plot).
+    """
+
+    model: tuple[str, ...] = ()
+    designs: str = "test"
+    budget_s: float = 20.0
+    out: str = "eval_out"
+    k: tuple[int, ...] = (1, 5, 10)
+    ablation_designs: int = 100
+    min_gt_length: int = 3
+    strips: int = 3
+    limit: int | None = None
+    workers: int = 2
+    timeout_s: float | None = None
+    seed: int = 0
+    project: str = "."
+    labels: str = "data/labels"
+    graphs: str = "data/zonegraphs/graphs"
+    metrics: str | None = None
+    plot_csv: str | None = None
 
 
 @dataclass(frozen=True)
@@ -124,15 +168,17 @@ def search_section(
         for t in targets
         if t.design_id in kept and (t.gt_length is None or t.gt_length >= args.min_gt_length)
     ][: args.limit]
-    searches = searches_for(guides, targets, args.k, args.ablation_designs, args.budget, args.seed)
-    print(f"report: {len(searches)} searches of {len(targets)} designs, budget {args.budget:g} s", flush=True)
+    searches = searches_for(guides, targets, args.k, args.ablation_designs, args.budget_s, args.seed)
+    print(
+        f"report: {len(searches)} searches of {len(targets)} designs, budget {args.budget_s:g} s", flush=True
+    )
 
     def progress(i: int, n: int) -> None:
         if i % 20 == 0 or i == n:
             print(f"  {i}/{n} searches", flush=True)
 
-    results = run_searches(searches, out / "records", args.workers, args.timeout, progress)
-    grid = time_grid(args.budget)
+    results = run_searches(searches, out / "records", args.workers, args.timeout_s, progress)
+    grid = time_grid(args.budget_s)
     table = pd.concat(
         [curves(group, grid).assign(k=k) for k, group in results.groupby("k", sort=True)], ignore_index=True
     )
@@ -264,37 +310,57 @@ def extras_section(args: argparse.Namespace, out: Path) -> str:
     return text
 
 
-def main() -> None:
+def _parser() -> argparse.ArgumentParser:
+    """The command line; every default is :class:`EvalConfig`'s."""
+    d = EvalConfig.defaults()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--model", nargs="*", default=[], help="network checkpoints to evaluate")
-    parser.add_argument("--designs", default="test", help="a split of the project, or a folder of parts")
-    parser.add_argument("--budget", type=float, default=20.0, help="search seconds per design")
-    parser.add_argument("--out", type=Path, default=Path("eval_out"))
-    parser.add_argument("--k", type=int, nargs="*", default=[1, 5, 10])
-    parser.add_argument("--ablation-designs", type=int, default=100)
-    parser.add_argument("--min-gt-length", type=int, default=3)
-    parser.add_argument("--strips", type=int, default=3, help="designs drawn as sequence strips")
-    parser.add_argument("--limit", type=int, default=None, help="the first N designs only")
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--timeout", type=float, default=None, help="per search (default 3 x budget + 60)")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--project", default=".", help="the pipeline project to read data/ from")
-    parser.add_argument("--labels", default="data/labels")
-    parser.add_argument("--graphs", default="data/zonegraphs/graphs")
+    parser.add_argument("--model", nargs="*", default=d["model"], help="network checkpoints to evaluate")
+    parser.add_argument(
+        "--designs", default=d["designs"], help="a split of the project, or a folder of parts"
+    )
+    parser.add_argument(
+        "--budget", dest="budget_s", type=float, default=d["budget_s"], help="search seconds per design"
+    )
+    parser.add_argument("--out", type=Path, default=d["out"])
+    parser.add_argument("--k", type=int, nargs="*", default=d["k"])
+    parser.add_argument("--ablation-designs", type=int, default=d["ablation_designs"])
+    parser.add_argument("--min-gt-length", type=int, default=d["min_gt_length"])
+    parser.add_argument("--strips", type=int, default=d["strips"], help="designs drawn as sequence strips")
+    parser.add_argument("--limit", type=int, default=d["limit"], help="the first N designs only")
+    parser.add_argument("--workers", type=int, default=d["workers"])
+    parser.add_argument(
+        "--timeout",
+        dest="timeout_s",
+        type=float,
+        default=d["timeout_s"],
+        help="per search (default 3 x budget + 60)",
+    )
+    parser.add_argument("--seed", type=int, default=d["seed"])
+    parser.add_argument("--project", default=d["project"], help="the pipeline project to read data/ from")
+    parser.add_argument("--labels", default=d["labels"])
+    parser.add_argument("--graphs", default=d["graphs"])
     parser.add_argument("--no-mlflow", action="store_true")
-    parser.add_argument("--metrics", default=None, help="also write the metrics JSON here")
-    parser.add_argument("--plot-csv", default=None, help="also write mean IoU vs time (k 5) here, wide")
+    parser.add_argument("--metrics", default=d["metrics"], help="also write the metrics JSON here")
+    parser.add_argument(
+        "--plot-csv", default=d["plot_csv"], help="also write mean IoU vs time (k 5) here, wide"
+    )
     parser.add_argument(
         "--params", type=Path, default=None, help="defaults from this file's evaluate section"
     )
+    return parser
+
+
+def main() -> None:
+    parser = _parser()
     args = parser.parse_args()
     if args.params is not None:
-        import yaml
-
-        section = (yaml.safe_load(args.params.read_text()) or {}).get("evaluate", {})
-        parser.set_defaults(**{k.replace("-", "_"): v for k, v in section.items()})
+        try:
+            section = load_section(EvalConfig, "evaluate", args.params)
+        except ConfigError as exc:
+            raise SystemExit(str(exc)) from None
+        parser.set_defaults(**asdict(section))
         args = parser.parse_args()
-    args.timeout = args.timeout or 3 * args.budget + 60
+    args.timeout_s = args.timeout_s or 3 * args.budget_s + 60
     for model in args.model:
         if not Path(model).is_file():
             raise SystemExit(f"{model}: error: no such model checkpoint")

@@ -19,11 +19,11 @@ import json
 from dataclasses import asdict, replace
 from pathlib import Path
 
-import yaml
-
 from eval.heldout import held_out_labelled, trained_projects
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
 from training.train import TrainConfig, train
+
+from .params import section
 
 
 def variants(base: TrainConfig, rounds: list[int]) -> dict[str, TrainConfig]:
@@ -58,9 +58,8 @@ def main() -> None:
     parser.add_argument("--eval-designs", type=int, default=100)
     parser.add_argument("--out", type=Path, default=Path("data/eval/ablations"))
     args = parser.parse_args()
-    section = yaml.safe_load(Path(args.params).read_text()).get("train", {})
     base = replace(
-        TrainConfig.from_mapping(section),
+        section(TrainConfig, "train", args.params),
         max_designs=args.designs,
         epochs=args.epochs,
         experiment="ablations",

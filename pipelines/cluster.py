@@ -15,10 +15,12 @@ from contextlib import contextmanager
 import dask
 from distributed import Client, LocalCluster
 
+from .params import DaskParams
+
 
 @contextmanager
-def dask_client(cfg: dict) -> Iterator[Client]:
-    address = cfg.get("scheduler")
+def dask_client(cfg: DaskParams) -> Iterator[Client]:
+    address = cfg.scheduler
     if address:
         with Client(address) as client:
             yield client
@@ -26,7 +28,7 @@ def dask_client(cfg: dict) -> Iterator[Client]:
     with dask.config.set({"distributed.worker.daemon": False}):
         with (
             LocalCluster(
-                n_workers=int(cfg.get("n_workers", 2)),
+                n_workers=cfg.n_workers,
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=None,

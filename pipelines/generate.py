@@ -29,7 +29,7 @@ from zonegraph.data.synthetic import design_seed, generate_design, synthetic_id
 from zonegraph.status import Status
 
 from .cluster import dask_client
-from .params import load_params
+from .params import PARAMS_FILE, DaskParams, DataParams, SyntheticParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -58,7 +58,7 @@ def convert_to_json(batch: str, design_id: str, path: str, timeout_s: float) -> 
     }
 
 
-def generate(count: int, seed: int, dask_cfg: dict, timeout: float, out: Path) -> Path:
+def generate(count: int, seed: int, dask_cfg: DaskParams, timeout: float, out: Path) -> Path:
     json_dir = out / "json"
     json_dir.mkdir(parents=True, exist_ok=True)
     code = code_fingerprint("generate")
@@ -76,7 +76,7 @@ def generate(count: int, seed: int, dask_cfg: dict, timeout: float, out: Path) -
 
 
 def convert_corpus(
-    root: Path, limit: int | None, seed: int, dask_cfg: dict, timeout: float, out: Path
+    root: Path, limit: int | None, seed: int, dask_cfg: DaskParams, timeout: float, out: Path
 ) -> pd.DataFrame:
     """Convert (a stratified sample of) the corpus; returns one row per design, failures included."""
     entries = list_corpus(root)
@@ -135,30 +135,19 @@ def main() -> None:
     parser.add_argument("--out", type=Path, required=True, help="the designs folder (index.parquet, json/)")
     parser.add_argument("--metrics", type=Path, required=True, help="the conversion metrics JSON")
     args = parser.parse_args()
-    params = load_params()
-    data = params["data"]
-    source = data.get("source", "synthetic")
-    limit = data.get("limit")
-    seed, fraction = int(data["split_seed"]), float(data["test_fraction"])
+    data, dask = section(DataParams, "data"), section(DaskParams, "dask")
+    source, limit = data.source, data.limit
+    seed, fraction = data.split_seed, data.test_fraction
     if source == "fusion_json":
-        folder = Path(data["fusion_json_dir"]).expanduser().resolve()
+        folder = Path(_folder(data.fusion_json_dir, "fusion_json_dir")).expanduser().resolve()
     elif source == "b123d":
-        root = Path(data["b123d_dir"]).expanduser().resolve()
-        table = convert_corpus(
-            root,
-            limit,
-            int(data.get("limit_seed", 0)),
-            params["dask"],
-            float(data.get("convert_timeout_s", 120)),
-            args.out,
-        )
+        root = Path(_folder(data.b123d_dir, "b123d_dir")).expanduser().resolve()
+        table = convert_corpus(root, limit, data.limit_seed, dask, data.convert_timeout_s, args.out)
         write_conversion(table, args.out, args.metrics)
         folder = args.out / "json"
     elif source == "synthetic":
-        syn = params["synthetic"]
-        folder = generate(
-            int(syn["count"]), int(syn["seed"]), params["dask"], float(syn["timeout_s"]), args.out
-        )
+        syn = section(SyntheticParams, "synthetic")
+        folder = generate(syn.count, syn.seed, dask, syn.timeout_s, args.out)
     else:
         raise SystemExit(f"generate: unknown data.source {source!r} (synthetic, fusion_json or b123d)")
     if source == "b123d":  # this run's converted designs (the folder may hold earlier runs' too)
@@ -174,6 +163,12 @@ def main() -> None:
         args.metrics.parent.mkdir(parents=True, exist_ok=True)
         args.metrics.write_text(json.dumps({"source": source, "designs": len(records)}, indent=2))
     print(f"generate: {len(records)} designs from {folder} ({source})")
+
+
+def _folder(value: str | None, key: str) -> str:
+    if value is None:
+        raise SystemExit(f"{PARAMS_FILE}: data: this source needs data.{key}")
+    return value
 
 
 def write_index(records: list[DesignRecord], table: pd.DataFrame | None, out: Path) -> None:

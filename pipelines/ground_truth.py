@@ -3,7 +3,7 @@
 For each design whose zone graph was built, the replay's tool bodies are mapped onto the saved
 (simplified) graph and onto the full graph, replayed on zones, and each step is tested for capture
 at proposal levels 1 and 3 (``zonegraph.sequence.ground_truth``); a design whose GT is not
-captured gets a heuristic search (``ground_truth.search_budget_s``) to tell "another sequence"
+captured gets a heuristic search (``ground_truth.budget_s``) to tell "another sequence"
 from "not reconstructed". Outputs: ``data/gt/steps.parquet`` (design, graph, step, operation, GT
 zone ids, captured and proposal count at each level, mapping check, reason),
 ``data/gt/designs.parquet`` (one row per design of the run, failures of earlier stages included),
@@ -23,7 +23,7 @@ from zonegraph.jobs import ground_truth_and_coverage
 from zonegraph.status import Status
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, GroundTruthParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -58,13 +58,12 @@ def main() -> None:
     parser.add_argument("--plot", type=Path, required=True, help="the coverage plot (PNG)")
     parser.add_argument("--metrics", type=Path, required=True, help="the coverage metrics JSON")
     args = parser.parse_args()
-    params = load_params()
-    cfg = params["ground_truth"]
-    levels = tuple(int(k) for k in cfg["levels"])
+    cfg = section(GroundTruthParams, "ground_truth")
+    levels = cfg.levels
     table = designs_table(args.designs, args.replay, args.zonegraphs)
     todo = table[table["graph_status"] == Status.OK]
     code = code_fingerprint("ground_truth")
-    settings = (levels, float(cfg["search_budget_s"]), bool(cfg["full_graph"]))
+    settings = (levels, cfg.budget_s, cfg.full_graph)
     jobs = []
     for row in todo.itertuples():
         graph = args.zonegraphs / "graphs" / row.design_id
@@ -77,14 +76,9 @@ def main() -> None:
                 cost=float(row.graph_zones),
             )
         )
-    with dask_client(params["dask"]) as client:
+    with dask_client(section(DaskParams, "dask")) as client:
         records = run_jobs(
-            ground_truth_and_coverage,
-            jobs,
-            args.out / "records",
-            client,
-            float(cfg["timeout_s"]),
-            "ground_truth",
+            ground_truth_and_coverage, jobs, args.out / "records", client, cfg.timeout_s, "ground_truth"
         )
     steps = [dict(step, design_id=r["design_id"]) for r in records for step in r.get("steps", [])]
     args.out.mkdir(parents=True, exist_ok=True)

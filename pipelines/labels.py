@@ -24,7 +24,7 @@ from zonegraph.jobs import label_and_save
 from zonegraph.status import Status
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, LabelsParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -53,24 +53,23 @@ def main() -> None:
     parser.add_argument("--metrics", type=Path, required=True, help="the label metrics JSON")
     args = parser.parse_args()
     out, graphs = args.out, args.zonegraphs / "graphs"
-    params = load_params()
-    cfg = params["labels"]
-    level, seed = int(cfg["level"]), int(cfg["seed"])
-    splits = list(cfg["splits"])
-    rank_splits = [s for s in cfg.get("rank_splits") or [] if s not in splits]
+    cfg = section(LabelsParams, "labels")
+    level, seed = cfg.level, cfg.seed
+    splits = list(cfg.splits)
+    rank_splits = [s for s in cfg.rank_splits if s not in splits]
     designs = pd.read_parquet(args.gt / "designs.parquet")
     steps = saved_graph_rows(pd.read_parquet(args.gt / "steps.parquet"))
     column = f"captured_l{level}"
     if column not in steps:
         raise SystemExit(f"labels: level {level} is not among ground_truth.levels ({column} missing)")
-    limit, limit_seed = cfg.get("limit"), int(cfg.get("limit_seed", 0))
+    limit, limit_seed = cfg.limit, cfg.limit_seed
     todo = pd.concat(
         [candidates(designs, splits, limit, limit_seed), candidates(designs, rank_splits, limit, limit_seed)]
     )
 
     def settings(split: str) -> tuple[int, int, float, int]:
-        multiplier = 0.0 if split in rank_splits else float(cfg["multiplier"])
-        return seed, level, multiplier, int(cfg["slack"])
+        multiplier = 0.0 if split in rank_splits else cfg.multiplier
+        return seed, level, multiplier, cfg.slack
 
     gt_of = {
         d: [
@@ -104,8 +103,8 @@ def main() -> None:
         for row in todo.itertuples()
         if row.design_id in gt_of
     ]
-    with dask_client(params["dask"]) as client:
-        records = run_jobs(label_and_save, jobs, out / "records", client, float(cfg["timeout_s"]), "labels")
+    with dask_client(section(DaskParams, "dask")) as client:
+        records = run_jobs(label_and_save, jobs, out / "records", client, cfg.timeout_s, "labels")
     keep = {r["design_id"] for r in records if r["status"] == Status.OK}
     for shard in [*out.glob("proposals/*.parquet"), *out.glob("steps/*.parquet")]:
         if shard.stem not in keep:  # a failed design or one of an earlier, different run

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,7 @@ from zonegraph.reconstruction import infer
 from zonegraph.status import Status
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, ReconstructParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 SEARCHED = (Status.EXACT, Status.PARTIAL, Status.REBUILD_FAILED)  # a search ran and gave a program
@@ -61,16 +62,15 @@ def main() -> None:
     parser.add_argument("--out", type=Path, required=True, help="the reconstructions folder")
     parser.add_argument("--metrics", type=Path, required=True, help="the reconstruction metrics JSON")
     args = parser.parse_args()
-    params = load_params()
-    cfg = params["reconstruct"]
+    cfg = section(ReconstructParams, "reconstruct")
     replayed = pd.read_parquet(args.replay / "manifest.parquet")
     test = replayed[(replayed["split"] == "test") & (replayed["status"] == Status.OK)]
     zones = pd.read_parquet(args.zonegraphs / "manifest.parquet").set_index("design_id")["zones"].fillna(0)
     code = code_fingerprint("reconstruct")
     jobs = []
-    for guide in cfg["guides"]:
-        config = InferConfig.from_mapping({**cfg, "guide": guide})
-        model = (cfg["model"],) if guide == "net" and cfg.get("model") else ()  # its weights count too
+    for guide in cfg.guides:
+        config = InferConfig.from_mapping({**asdict(cfg), "guide": guide})
+        model = (cfg.model,) if guide == "net" and cfg.model else ()  # its weights count too
         for row in test.itertuples():
             brep = f"{row.brep_dir}/final.brep"
             graph = args.zonegraphs / "graphs" / row.design_id
@@ -82,9 +82,9 @@ def main() -> None:
                     cost=float(zones.get(row.design_id, 0)),
                 )
             )
-    with dask_client(params["dask"]) as client:
+    with dask_client(section(DaskParams, "dask")) as client:
         records = run_jobs(
-            reconstruct_design, jobs, args.out / "records", client, float(cfg["timeout_s"]), "reconstruct"
+            reconstruct_design, jobs, args.out / "records", client, cfg.timeout_s, "reconstruct"
         )
     results = pd.DataFrame(records).drop(columns=["fingerprint"])
     results[["guide", "design_id"]] = results["design_id"].str.split("__", n=1, expand=True)

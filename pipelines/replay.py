@@ -19,7 +19,7 @@ from zonegraph.geometry.shapes import write_brep
 from zonegraph.status import Status
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, ReplayParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -54,7 +54,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, required=True, help="the replay folder (manifest, breps)")
     parser.add_argument("--metrics", type=Path, required=True, help="the replay metrics JSON")
     args = parser.parse_args()
-    params = load_params()
+    cfg = section(ReplayParams, "replay")
     index = pd.read_parquet(args.designs / "index.parquet")
     code = code_fingerprint("replay")
     jobs = [
@@ -65,10 +65,8 @@ def main() -> None:
         )
         for row in index.itertuples()
     ]
-    with dask_client(params["dask"]) as client:
-        records = run_jobs(
-            replay_design, jobs, args.out / "records", client, float(params["replay"]["timeout_s"]), "replay"
-        )
+    with dask_client(section(DaskParams, "dask")) as client:
+        records = run_jobs(replay_design, jobs, args.out / "records", client, cfg.timeout_s, "replay")
     manifest = pd.DataFrame(records).drop(columns=["fingerprint"])
     manifest.insert(1, "split", index["split"].to_numpy())
     manifest.to_parquet(args.out / "manifest.parquet", index=False)

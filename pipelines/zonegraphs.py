@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +20,7 @@ from zonegraph.jobs import build_and_save
 from zonegraph.status import Status
 
 from .cluster import dask_client
-from .params import load_params
+from .params import DaskParams, ZoneGraphParams, section
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -29,12 +30,11 @@ def main() -> None:
     parser.add_argument("--out", type=Path, required=True, help="the zone graphs folder (manifest, graphs)")
     parser.add_argument("--metrics", type=Path, required=True, help="the zone graph metrics JSON")
     args = parser.parse_args()
-    params = load_params()
-    cfg = params["zonegraph"]
+    cfg = section(ZoneGraphParams, "zonegraph")
     replayed = pd.read_parquet(args.replay / "manifest.parquet")
     ok = replayed[replayed["status"] == Status.OK]
     code = code_fingerprint("zonegraphs")
-    config = BuildConfig.from_mapping(cfg)
+    config = BuildConfig.from_mapping(asdict(cfg))  # the section less the stage's timeout
     jobs = [
         Job(
             row.design_id,
@@ -44,10 +44,8 @@ def main() -> None:
         )
         for row in ok.itertuples()
     ]
-    with dask_client(params["dask"]) as client:
-        records = run_jobs(
-            build_and_save, jobs, args.out / "records", client, float(cfg["timeout_s"]), "zonegraphs"
-        )
+    with dask_client(section(DaskParams, "dask")) as client:
+        records = run_jobs(build_and_save, jobs, args.out / "records", client, cfg.timeout_s, "zonegraphs")
     built = pd.DataFrame(records).drop(columns=["fingerprint"])
     skipped = replayed.loc[replayed["status"] != Status.OK, ["design_id", "status", "reason"]]
     manifest = pd.concat([built, skipped], ignore_index=True)

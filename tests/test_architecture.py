@@ -13,13 +13,15 @@ import zonegraph
 PACKAGE = Path(zonegraph.__file__).parent
 # Each layer may import only layers of a lower rank (and itself); data and zones are siblings, as
 # are export and network.
-# errors, console (capturing native output) and plugins (the guides, by name) import nothing heavy
-# and serve every layer; status, the vocabulary of outcomes, sits below them all (errors name theirs).
+# errors, console (capturing native output), plugins (the guides, by name) and configs (the Config
+# idiom every layer's settings use) import nothing heavy and serve every layer; status, the
+# vocabulary of outcomes, sits below them all (errors name theirs).
 RANK = {
     "status": -1,
     "errors": 0,
     "console": 0,
     "plugins": 0,
+    "configs": 0,
     "geometry": 1,
     "data": 2,
     "zones": 2,
@@ -27,7 +29,7 @@ RANK = {
     "export": 4,
     "network": 4,  # the network guide at inference: model, encoding, checkpoint, ranker
 }
-TOP = 5  # reconstruction, cli, batch, jobs, isolation, outputs, configs and the package root
+TOP = 5  # reconstruction, cli, batch, jobs, isolation, outputs and the package root
 # The one layer that may import these, and which no other imports at module level: the rest reach
 # the network guide through zonegraph.plugins, by reference, so a core install never needs torch.
 TORCH = ("torch", "torch_geometric")

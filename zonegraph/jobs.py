@@ -75,7 +75,7 @@ def ground_truth_and_coverage(
     graph_dir: str,
     operations: list[str],
     levels: tuple[int, ...] = (1, 3),
-    search_budget_s: float = 2.0,
+    budget_s: float = 2.0,
     full_graph: bool = True,
 ) -> dict[str, Any]:
     """A design's ground truth on its saved (simplified) zone graph, and on the full graph.
@@ -85,7 +85,7 @@ def ground_truth_and_coverage(
         graph_dir: the zonegraphs stage's saved graph of ``final.brep``.
         operations: Fusion's operation of each extrude, in timeline order.
         levels: proposal levels at which capture is tested.
-        search_budget_s: heuristic search budget for a graph whose GT is not captured at level 1
+        budget_s: heuristic search seconds for a graph whose GT is not captured at level 1
             (does another sequence reach the target?).
         full_graph: also build the unsimplified graph when simplification changed it.
 
@@ -113,7 +113,7 @@ def ground_truth_and_coverage(
         gt = ground_truth(g, tools, operations, levels)
         exact = None
         if not gt.captured(1):
-            result = search(g, HeuristicRanker(), SearchConfig(budget_s=search_budget_s))
+            result = search(g, HeuristicRanker(), SearchConfig(budget_s=budget_s))
             exact = result.exact
         out[f"{name}_status"] = Status.OK
         out[f"{name}_zones"] = g.n_zones

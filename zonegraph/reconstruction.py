@@ -85,10 +85,6 @@ class InferResult:
         return {**asdict(self), "status": self.status.value}
 
 
-def _search_config(config: InferConfig, budget_s: float) -> SearchConfig:
-    return SearchConfig(k=config.k, k_decay=config.k_decay, max_depth=config.max_depth, budget_s=budget_s)
-
-
 def input_unit(path: Path) -> Unit:
     """What the target's numbers mean: design JSON is in cm; STEP is read in mm (BREP has no unit)."""
     return Unit.CM if path.suffix.lower() == ".json" else Unit.MM
@@ -150,7 +146,8 @@ def reconstruct(
         build_s += seconds
         left = config.budget_s - search_s
         gen = ProposalGenerator(graph, level=config.level)
-        result = search(graph, ranker, _search_config(config, left * budget_share(graph, simplify)), gen)
+        settings = {**asdict(config), "budget_s": left * budget_share(graph, simplify)}
+        result = search(graph, ranker, SearchConfig.from_mapping(settings), gen)
         if best is None or (result.iou, -len(result.steps)) > (best[2].iou, -len(best[2].steps)):
             trace += _improvements(result, search_s, best[2].iou if best else -1.0)
             best = (graph, gen, result)

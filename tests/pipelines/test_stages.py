@@ -26,7 +26,7 @@ def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):
         "dask": {"scheduler": None, "n_workers": 2},
         "replay": {"timeout_s": 60},
         "zonegraph": {"simplify": True, "samples": 16, "seed": 0, "timeout_s": 120},
-        "ground_truth": {"levels": [1, 3], "full_graph": True, "search_budget_s": 0.5, "timeout_s": 120},
+        "ground_truth": {"levels": [1, 3], "full_graph": True, "budget_s": 0.5, "timeout_s": 120},
         "labels": {
             "splits": ["train"],
             "rank_splits": ["test"],

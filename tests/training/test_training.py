@@ -207,5 +207,7 @@ def test_an_ablation_variant_trains_once_then_is_reused(labelled, tmp_path, monk
     assert torch.load(path, weights_only=True)["model"]["rounds"] == 0
     written = path.stat().st_mtime_ns
     assert train_variant("rounds0", configs["rounds0"], tmp_path / "out").stat().st_mtime_ns == written
-    other = train_variant("rounds0", replace(configs["rounds0"], lr=1e-3), tmp_path / "out")
+    other = train_variant(
+        "rounds0", replace(configs["rounds0"], lr=configs["rounds0"].lr * 10), tmp_path / "out"
+    )
     assert other.stat().st_mtime_ns != written  # another config: trained again

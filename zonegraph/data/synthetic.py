@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from build123d import Face, GeomType, Shape, Solid, Vector
 
+from zonegraph.configs import Config
 from zonegraph.data.design import (
     Arc,
     Circle,
@@ -62,7 +63,7 @@ FUSION_SURFACE_TYPES = {
 
 
 @dataclass(frozen=True)
-class SyntheticConfig:
+class SyntheticConfig(Config):
     """Knobs of the design distribution; defaults mimic the published data set."""
 
     max_extrudes: int = 12

@@ -31,6 +31,6 @@ def load_scorer(path: str | Path, device: str = "cpu") -> ProposalScorer:
 
 def scorer_from(checkpoint: dict[str, Any], device: str = "cpu") -> ProposalScorer:
     """The scorer a loaded checkpoint holds, in eval mode."""
-    model = ProposalScorer(ModelConfig(**checkpoint["model"]))
+    model = ProposalScorer(ModelConfig.from_mapping(checkpoint["model"], strict=True))
     model.load_state_dict(checkpoint["state_dict"])
     return model.eval().to(device)

@@ -23,28 +23,27 @@ proposal of each zone), ``edge_index`` (2, E) holds both directions of every adj
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import torch
 from torch import Tensor, nn
 from torch_geometric.nn import MessagePassing, global_max_pool
 
+from zonegraph.configs import Config
+
 FLAGS = 4  # in target, in canvas, in extrusion, operation
 HIDDEN = 128
 
 
 @dataclass(frozen=True)
-class ModelConfig:
+class ModelConfig(Config):
     """What the ablations vary: the fusion, the rounds of message passing, the point geometry."""
 
     fusion: str = "late"  # "early", "late" or "factored"
     rounds: int = 3
     use_points: bool = True  # False: zones are their flags only (the geometry ablation)
     hidden: int = HIDDEN
-
-    def to_dict(self) -> dict:
-        return asdict(self)
 
 
 def _mlp(sizes: list[int], last_plain: bool = True) -> nn.Sequential:

@@ -16,13 +16,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from zonegraph.configs import Config
 from zonegraph.sequence.proposals import Proposal, ProposalGenerator
 from zonegraph.sequence.rankers import Ranker, zone_iou
 from zonegraph.zones.model import ZoneGraph
 
 
 @dataclass(frozen=True)
-class SearchConfig:
+class SearchConfig(Config):
     """How far a search may go: top-k width (shrinking with depth), depth, time and work bounds.
 
     Args:
@@ -32,6 +33,9 @@ class SearchConfig:
         budget_s: wall-clock budget in seconds.
         max_expansions: a work bound (states expanded); unlike seconds it is the same on any
             machine, so seeded runs bounded by it are reproducible.
+
+    ``zonegraph infer`` derives it from its :class:`~zonegraph.configs.InferConfig` (which holds
+    every field but ``max_expansions``) with ``SearchConfig.from_mapping(asdict(infer_config))``.
     """
 
     k: int = 5
