@@ -19,6 +19,7 @@ RANK = {
     "console": 0,
     "plugins": 0,
     "status": 0,
+    "verified": 0,
     "geometry": 1,
     "data": 2,
     "zones": 2,

@@ -14,10 +14,11 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import CORPUS, requires_corpus
-from zonegraph.data.b123d import ConvertedDesign, CorpusEntry, convert_batch, convert_design, list_corpus
+from zonegraph.data.b123d import ConvertedDesign, CorpusEntry, convert_design, list_corpus
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
+from zonegraph.jobs import convert_batch
 
 STATUSES = {
     "ok",
@@ -29,7 +30,8 @@ STATUSES = {
     "fusion_mismatch",
     "replay_failed",
     "timeout",
-    "error",
+    "crash",
+    "bug",
 }
 
 # Small designs chosen (by grepping the scripts) so that together they use every operation and
@@ -55,7 +57,7 @@ _CACHE: dict[str, ConvertedDesign] = {}
 def _converted(feature: str) -> ConvertedDesign:
     if feature not in _CACHE:
         batch, design_id = FEATURES[feature]
-        _CACHE[feature] = convert_design(CORPUS / batch, design_id, timeout_s=120)
+        _CACHE[feature] = convert_design(CORPUS / batch, design_id)
     return _CACHE[feature]
 
 
@@ -169,7 +171,7 @@ def test_overlapping_new_bodies_compare_as_union() -> None:
 
 
 def _convert(entry: CorpusEntry) -> ConvertedDesign:
-    return convert_design(entry.batch, entry.design_id, entry.fusion_volume, entry.fusion_area, timeout_s=120)
+    return convert_design(entry.batch, entry.design_id, entry.fusion_volume, entry.fusion_area)
 
 
 @requires_corpus
@@ -310,9 +312,16 @@ def _write(tmp_path: Path, name: str, text: str) -> Path:
     return path
 
 
+def _convert_batch(path: Path) -> dict[str, ConvertedDesign]:
+    """Each design in a child forked from a fresh interpreter: forking this process after earlier
+    tests ran OpenCASCADE in it can deadlock."""
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+        return {r.design_id: r for r in pool.submit(convert_batch, path).result()}
+
+
 def test_taper_sign_two_sides_and_shims(tmp_path: Path) -> None:
     path = _write(tmp_path, "batch_001.py", GOOD)
-    results = {r.design_id: r for r in convert_batch(path)}
+    results = _convert_batch(path)
     box = results["box_taper"]
     # replay matches the script; Fusion's numbers here are fake, so only that check fails
     assert box.status == "fusion_mismatch" and "script: " in box.reason
@@ -344,7 +353,7 @@ def test_bad_batches_give_statuses(tmp_path: Path) -> None:
     assert [e.design_id for e in list_corpus(tmp_path)] == ["box_taper", "spline"]  # listed anyway
 
     bad = _write(tmp_path, "batch_003.py", BAD)
-    results = {r.design_id: r for r in convert_batch(bad)}
+    results = _convert_batch(bad)
     assert results["raises"].status == "model_raised"
     assert results["raises"].reason and "\n" not in results["raises"].reason
     assert results["none"].status == "no_shape"
