@@ -60,7 +60,7 @@ def load_batch(batch_path: str | Path) -> _Batch:
         install_api_shims(module)
     except SyntaxError as exc:
         module, error = None, f"SyntaxError: {exc.msg} (line {exc.lineno})"
-    except Exception as exc:  # whatever the module's top level raises
+    except (Exception, SystemExit) as exc:  # whatever the module's top level raises, sys.exit too
         module, error = None, f"import failed: {type(exc).__name__}: {one_line(exc)}"
     batch = _Batch(key, module, error, lines, spans)
     _BATCHES[key] = batch
