@@ -6,6 +6,7 @@ and the taper sign use small batch files written to ``tmp_path``.
 
 from __future__ import annotations
 
+import json
 import math
 import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
@@ -19,6 +20,7 @@ from zonegraph.data.dataset import stratified_sample
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
 from zonegraph.jobs import convert_batch
+from zonegraph.verified import FUSION_FIELD, FUSION_RTOL
 
 STATUSES = {
     "ok",
@@ -87,6 +89,9 @@ def _assert_verified(r: ConvertedDesign) -> None:
     design = parse_design(r.design_json, r.design_id)
     assert len(design.extrudes) == r.steps == len(r.operations)
     assert design.properties is not None and design.properties.volume > 0
+    fusion = r.design_json[FUSION_FIELD]  # Fusion's figures beside our replay's own
+    assert fusion["volume_rel_difference"] == r.fusion_volume_rel_error
+    assert fusion["area_rel_difference"] == r.fusion_area_rel_error
 
 
 # ------------------------------------------------------------------------------------- corpus
@@ -359,3 +364,26 @@ def test_bad_batches_give_statuses(tmp_path: Path) -> None:
     assert results["none"].status == "no_shape"
     assert results["empty"].status == "no_shape"
     assert convert_design(bad, "missing").status == "syntax_error"
+
+
+# A real design whose Fusion figures differ from our replay's by ~1e-5..1e-4 (spline profiles):
+# before issue 29 its converted file carried Fusion's figures and ``zonegraph replay`` refused it.
+FUSION_APART = ("01_2ops/batch_016.py", "60730_fa513b8a_0003")
+
+
+@requires_corpus
+def test_a_file_convert_calls_ok_replays_verified_though_fusion_differs(tmp_path: Path) -> None:
+    from zonegraph.data.design import load_design
+    from zonegraph.verified import REPLAY_RTOL, disagreement
+
+    batch, design_id = FUSION_APART
+    r = convert_design(CORPUS / batch, design_id)
+    assert r.status == "ok", r.reason
+    assert r.design_json is not None
+    assert 1e-6 < max(r.fusion_volume_rel_error or 0, r.fusion_area_rel_error or 0) < FUSION_RTOL
+    path = tmp_path / f"{design_id}.json"
+    path.write_text(json.dumps(r.design_json))
+    result = replay(load_design(path))
+    assert result.disagreement() is None  # what ``zonegraph replay`` checks, at REPLAY_RTOL
+    fusion = r.design_json[FUSION_FIELD]
+    assert disagreement(result.measured(), fusion["volume"], fusion["area"], None, REPLAY_RTOL) is not None
