@@ -74,7 +74,7 @@ def summarise(rows: list[dict]) -> str:
     ]
     vol = Counter(_decade(r["fusion_volume_rel_difference"]) for r in ok)
     area = Counter(_decade(r["fusion_area_rel_difference"]) for r in ok)
-    for key in sorted(set(vol) | set(area), key=lambda k: (k.startswith("<"), k)):
+    for key in sorted(set(vol) | set(area), key=lambda k: -99 if k.startswith("<") else -int(k[3:] or 99)):
         lines.append(f"| {key} | {vol.get(key, 0)} | {area.get(key, 0)} |")
     above = [
         r

@@ -366,9 +366,9 @@ def test_bad_batches_give_statuses(tmp_path: Path) -> None:
     assert convert_design(bad, "missing").status == "syntax_error"
 
 
-# A real design whose Fusion figures differ from our replay's by ~1e-5..1e-4 (spline profiles):
+# A real design whose Fusion figures differ from our replay's by ~1e-4 (volume 5e-5, area 3e-4):
 # before issue 29 its converted file carried Fusion's figures and ``zonegraph replay`` refused it.
-FUSION_APART = ("01_2ops/batch_016.py", "60730_fa513b8a_0003")
+FUSION_APART = ("07_16to20ops/batch_003.py", "55749_6526b76b_0000")
 
 
 @requires_corpus
@@ -380,7 +380,7 @@ def test_a_file_convert_calls_ok_replays_verified_though_fusion_differs(tmp_path
     r = convert_design(CORPUS / batch, design_id)
     assert r.status == "ok", r.reason
     assert r.design_json is not None
-    assert 1e-6 < max(r.fusion_volume_rel_error or 0, r.fusion_area_rel_error or 0) < FUSION_RTOL
+    assert 1e-5 < max(r.fusion_volume_rel_error or 0, r.fusion_area_rel_error or 0) < 1e-3 < FUSION_RTOL
     path = tmp_path / f"{design_id}.json"
     path.write_text(json.dumps(r.design_json))
     result = replay(load_design(path))
