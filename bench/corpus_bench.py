@@ -27,8 +27,9 @@ import numpy as np
 
 from bench.corpus import CORPUS, require_corpus, run_designs, write_results
 from zonegraph.configs import InferConfig
-from zonegraph.data.b123d import CorpusEntry, convert_design, list_corpus
+from zonegraph.data.b123d import CorpusEntry, list_corpus
 from zonegraph.isolation import run_isolated
+from zonegraph.jobs import convert_isolated
 from zonegraph.reconstruction import infer
 from zonegraph.status import Status
 
@@ -56,7 +57,7 @@ def split_ids(index: Path, split: str) -> set[str]:
 
 def _infer(entry: CorpusEntry, config: InferConfig, work: str) -> dict:
     """Convert one design, then infer its final shape as a user would."""
-    converted = convert_design(entry.batch, entry.design_id, timeout_s=120)
+    converted = convert_isolated(entry.batch, entry.design_id, timeout=120)
     if not converted.ok or converted.design_json is None:
         return {"status": f"convert_{converted.status}", "reason": converted.reason}
     path = Path(work) / f"{entry.design_id}.json"

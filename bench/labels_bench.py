@@ -26,11 +26,12 @@ from pathlib import Path
 import numpy as np
 
 from bench.corpus import CORPUS, require_corpus, run_designs, write_results
-from zonegraph.data.b123d import CorpusEntry, convert_design, list_corpus
+from zonegraph.data.b123d import CorpusEntry, list_corpus
 from zonegraph.data.dataset import stratified_sample, test_ids
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.isolation import run_isolated
+from zonegraph.jobs import convert_isolated
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.labels import NEGATIVE, NEUTRAL, POSITIVE, GTOperation, label_design
 from zonegraph.status import Status
@@ -49,7 +50,7 @@ def training_sample(corpus: Path, count: int, seed: int) -> list[CorpusEntry]:
 
 def _label(entry: CorpusEntry, work: str, seed: int, level: int, multiplier: float, slack: int) -> dict:
     t0 = time.perf_counter()
-    converted = convert_design(entry.batch, entry.design_id, timeout_s=120)
+    converted = convert_isolated(entry.batch, entry.design_id, timeout=120)
     if not converted.ok or converted.design_json is None:
         return {"status": f"convert_{converted.status}", "reason": converted.reason}
     path = Path(work) / f"{entry.design_id}.json"

@@ -40,13 +40,15 @@ def write_design(design_id: str, seed: int, path: str) -> dict[str, Any]:
     return {"extrudes": sum(e["type"] == "ExtrudeFeature" for e in data["entities"].values())}
 
 
-def convert_to_json(batch: str, design_id: str, path: str, timeout_s: float) -> dict[str, Any]:
-    """Job body: one corpus design converted and verified; its JSON written when it is ok."""
-    result = convert_design(batch, design_id, timeout_s=timeout_s)
+def convert_to_json(batch: str, design_id: str, path: str) -> dict[str, Any]:
+    """Job body (in a killable child): one corpus design converted and verified; its JSON written
+    when it is ok. Both relative differences of our replay from Fusion's figures are kept, so the
+    replay-vs-Fusion table of the whole corpus comes from ``conversion.parquet``."""
+    result = convert_design(batch, design_id)
     if result.ok and result.design_json is not None:
         Path(path).write_text(json.dumps(result.design_json))
     return {
-        "convert_status": result.status,
+        "convert_status": str(result.status),
         "convert_reason": result.reason,
         "folder": result.folder,
         "steps": result.steps,
@@ -55,6 +57,9 @@ def convert_to_json(batch: str, design_id: str, path: str, timeout_s: float) -> 
         "volume_rel_error": result.volume_rel_error,
         "area_rel_error": result.area_rel_error,
         "fusion_volume_rel_error": result.fusion_volume_rel_error,
+        "fusion_area_rel_error": result.fusion_area_rel_error,
+        "script_fusion_volume_rel_error": result.script_fusion_volume_rel_error,
+        "script_fusion_area_rel_error": result.script_fusion_area_rel_error,
     }
 
 
@@ -88,15 +93,15 @@ def convert_corpus(
         Job(
             e.design_id,
             fingerprint(code, timeout, files=(e.batch,)),
-            (e.batch, e.design_id, str(json_dir / f"{e.design_id}.json"), timeout),
+            (e.batch, e.design_id, str(json_dir / f"{e.design_id}.json")),
         )
         for e in entries
     ]
-    with dask_client(dask_cfg) as client:  # the child's own alarm fires first; the kill is the backstop
-        records = run_jobs(convert_to_json, jobs, out / "convert_records", client, timeout + 30, "convert")
+    with dask_client(dask_cfg) as client:  # each design in a child killed at its timeout
+        records = run_jobs(convert_to_json, jobs, out / "convert_records", client, timeout, "convert")
     table = pd.DataFrame(records).drop(columns=["fingerprint"])
     table["folder"] = [e.folder for e in entries]
-    failed = table["status"] != Status.OK  # the child itself timed out or crashed
+    failed = table["status"] != Status.OK  # the child timed out, crashed or met a bug of ours
     table.loc[failed, "convert_status"] = table.loc[failed, "status"]
     table.loc[failed, "convert_reason"] = table.loc[failed, "reason"]
     for row in table.itertuples():

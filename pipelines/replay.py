@@ -17,6 +17,7 @@ from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.geometry.shapes import write_brep
 from zonegraph.status import Status
+from zonegraph.verified import REPLAY_RTOL
 
 from .cluster import dask_client
 from .params import DaskParams, ReplayParams, section
@@ -43,6 +44,7 @@ def replay_design(path: str, out_dir: str) -> dict:
         "bodies": s["body_count"],
         "volume_rel_error": check.get("volume_rel_error"),
         "area_rel_error": check.get("area_rel_error"),
+        "verified": result.disagreement(REPLAY_RTOL) is None,  # zonegraph.verified's definition
         "replay_seconds": s["seconds"],
         "brep_dir": str(out),
     }

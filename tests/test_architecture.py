@@ -22,6 +22,7 @@ RANK = {
     "console": 0,
     "plugins": 0,
     "configs": 0,
+    "verified": 0,
     "geometry": 1,
     "data": 2,
     "zones": 2,

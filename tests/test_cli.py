@@ -73,7 +73,10 @@ def test_convert_writes_verified_json_and_a_summary(tmp_path):
     batch = tmp_path / "01_2ops" / "batch_001.py"
     batch.parent.mkdir()
     batch.write_text(BATCH)
-    assert main(["convert", str(tmp_path), "--out", str(tmp_path / "out")]) == 0
+    # a fresh process, as a user runs it: forking this one after earlier tests ran OpenCASCADE
+    # in it can deadlock the design's child
+    proc = _cli("convert", str(tmp_path), "--out", str(tmp_path / "out"))
+    assert proc.returncode == 0, proc.stderr
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     status = {d["design_id"]: d["status"] for d in summary["designs"]}
     assert status == {"1_a_0000": "ok", "1_b_0000": "model_raised"}

@@ -121,7 +121,7 @@ def test_a_corpus_design_with_noise_exports_short_numbers(tmp_path: Path) -> Non
     from zonegraph.data.b123d import convert_design
 
     batch, design_id = NOISY_CORPUS_DESIGN
-    converted = convert_design(CORPUS / batch, design_id, timeout_s=120)
+    converted = convert_design(CORPUS / batch, design_id)
     assert converted.ok and converted.design_json is not None, converted.reason
     path = tmp_path / f"{design_id}.json"
     path.write_text(json.dumps(converted.design_json))

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from zonegraph.configs import BuildConfig, InferConfig
 from zonegraph.errors import ZoneGraphError
+from zonegraph.verified import REPLAY_RTOL
 
 if TYPE_CHECKING:  # imported where used, so that ``zonegraph --help`` loads nothing it need not
     from zonegraph.batch import BatchJob
@@ -206,10 +207,45 @@ def _cmd_infer(args: argparse.Namespace) -> int:
 
 
 def _cmd_convert(args: argparse.Namespace) -> int:
-    from zonegraph.data.b123d import ConvertedDesign, convert_batch
-    from zonegraph.isolation import run_isolated
+    """Every design of the batches in a killable child under ``--timeout``; the JSON of each design
+    converted ``ok`` and ``summary.json`` (a row per design) moved into ``--out`` together at the
+    end. Exit 2 when nothing converted, 1 when a design met a bug of ours (its traceback shown)."""
+    from zonegraph.isolation import Outcome
+    from zonegraph.outputs import run_staged, write_record
+    from zonegraph.status import Status
 
-    source = Path(args.source)
+    batches = _convert_batches(Path(args.source))
+    import build123d  # noqa: F401 - imported once here, inherited by every design's child
+
+    from zonegraph.data.b123d import install_ocp_shims
+
+    install_ocp_shims()
+    rows: list[dict[str, Any]] = []
+
+    def run(scratch: Path) -> Outcome:
+        rows.extend(_convert_into(batches, scratch, args.timeout))
+        summary = _convert_summary(rows)
+        (scratch / "summary.json").write_text(summary)
+        converted = any(row["status"] == Status.OK for row in rows)
+        return Outcome(Status.OK if converted else Status.NOTHING_CONVERTED, summary)
+
+    out = Path(args.out)
+    outcome = run_staged(run, out)
+    if not outcome.ok:  # the failed rows still say why, as a failed part's error.json does
+        write_record(out, "summary.json", outcome.value)
+    counts = json.loads(outcome.value)["counts"]
+    for row in rows:
+        if row.get("traceback"):
+            print(row["traceback"], file=sys.stderr, end="")
+    print(f"converted {counts.get('ok', 0)} of {len(rows)} designs -> {out} (by status {counts})")
+    if counts.get(Status.BUG.value):
+        print("zonegraph: internal error while converting (a bug: please report it)", file=sys.stderr)
+        return EXIT_BUG
+    return 0 if outcome.ok else EXIT_USER_ERROR
+
+
+def _convert_batches(source: Path) -> list[Path]:
+    """The batch files of ``source`` (a file or a folder searched recursively)."""
     if source.is_dir():
         batches = sorted(source.rglob("batch_*.py"))
     elif source.is_file():
@@ -218,38 +254,50 @@ def _cmd_convert(args: argparse.Namespace) -> int:
         raise ZoneGraphError(str(source), "no such batch file or folder")
     if not batches:
         raise ZoneGraphError(str(source), "no batch_*.py files in the folder")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    rows: list[dict] = []
-    for batch in batches:  # one killable child per batch: a hung OpenCASCADE call stops only it
-        outcome = run_isolated(convert_batch, (str(batch), args.timeout), timeout=None)
-        results: list[ConvertedDesign] = outcome.value if outcome.ok else []
-        if not outcome.ok:
-            rows.append(
-                {"batch": str(batch), "design_id": None, "status": outcome.status, "reason": outcome.reason}
-            )
-        for r in results:
+    return batches
+
+
+def _convert_into(batches: list[Path], out: Path, timeout: float) -> list[dict[str, Any]]:
+    """A row per design, each converted in its own child (the batch is listed without running it,
+    so a model's ``os._exit`` or endless loop stops only that design); its JSON written when ok."""
+    from zonegraph.data.b123d import batch_entries
+    from zonegraph.jobs import convert_isolated
+    from zonegraph.status import Status
+
+    rows: list[dict[str, Any]] = []
+    for batch in batches:
+        entries = batch_entries(batch, batch.parent.name)
+        ok = 0
+        for e in entries:
+            r = convert_isolated(batch, e.design_id, e.fusion_volume, e.fusion_area, timeout)
             if r.ok and r.design_json is not None:
                 (out / f"{r.design_id}.json").write_text(json.dumps(r.design_json))
-            rows.append(
-                {
-                    "batch": str(batch),
-                    "design_id": r.design_id,
-                    "folder": r.folder,
-                    "status": r.status,
-                    "reason": r.reason,
-                    "steps": r.steps,
-                    "seconds": round(r.seconds, 4),
-                }
-            )
-        ok = sum(r.ok for r in results)
-        print(f"{batch.parent.name}/{batch.name}: {ok}/{len(results)} converted", flush=True)
+                ok += 1
+            row = {
+                "batch": str(batch),
+                "design_id": r.design_id,
+                "folder": r.folder,
+                "status": str(r.status),
+                "reason": r.reason,
+                "steps": r.steps,
+                "seconds": round(r.seconds, 4),
+                "fusion_volume_rel_error": r.fusion_volume_rel_error,
+                "fusion_area_rel_error": r.fusion_area_rel_error,
+            }
+            if r.status == Status.BUG:
+                row["traceback"] = r.notes[0] if r.notes else ""
+            elif not r.ok:
+                print(f"zonegraph: {batch}: {r.design_id}: {r.status}: {r.reason}", file=sys.stderr)
+            rows.append(row)
+        print(f"{batch.parent.name}/{batch.name}: {ok}/{len(entries)} converted", flush=True)
+    return rows
+
+
+def _convert_summary(rows: list[dict[str, Any]]) -> str:
     counts: dict[str, int] = {}
     for row in rows:
         counts[row["status"]] = counts.get(row["status"], 0) + 1
-    (out / "summary.json").write_text(json.dumps({"counts": counts, "designs": rows}, indent=1))
-    print(f"converted {counts.get('ok', 0)} of {len(rows)} designs -> {out} (by status {counts})")
-    return 0
+    return json.dumps({"counts": counts, "designs": rows}, indent=1)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -262,7 +310,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--tolerance",
         type=float,
-        default=1e-6,
+        default=REPLAY_RTOL,
         help="largest relative volume and area error against the file's properties (else exit 2)",
     )
     p.add_argument("--no-check", action="store_true", help="keep the result whatever the file's properties")
@@ -281,7 +329,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("convert", help="convert build123d corpus batches to verified design JSON")
     p.add_argument("source", help="a batch_NNN.py file or a folder of them (searched recursively)")
     p.add_argument("--out", required=True, help="output folder (one JSON per design, summary.json)")
-    p.add_argument("--timeout", type=float, default=120.0, help="seconds per design")
+    p.add_argument(
+        "--timeout", type=float, default=120.0, help="seconds per design (each runs in its own process)"
+    )
     p.set_defaults(func=_cmd_convert)
     d = InferConfig.defaults()
     p = sub.add_parser("infer", help="infer an editable sketch + extrude program that rebuilds a part")

@@ -11,11 +11,13 @@ import numpy as np
 import pyarrow.parquet as pq
 
 from zonegraph.configs import BuildConfig
+from zonegraph.data.b123d import ConvertedDesign, batch_entries, convert_design
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.data.targets import load_target
 from zonegraph.errors import ReplayMismatchError
 from zonegraph.geometry.shapes import read_shape, read_solids, write_step
+from zonegraph.isolation import run_isolated
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.ground_truth import ground_truth, search_op
 from zonegraph.sequence.labels import GTOperation, label_design, label_tables
@@ -188,3 +190,40 @@ def label_and_save(
         "completions": int(sum(proposals.column("completions").to_pylist())),
         "zones": graph.n_zones,
     }
+
+
+def convert_isolated(
+    batch_path: str | Path,
+    design_id: str,
+    fusion_volume: float | None = None,
+    fusion_area: float | None = None,
+    timeout: float = 120.0,
+) -> ConvertedDesign:
+    """:func:`convert_design` in a forked child killed after ``timeout`` seconds: the design's
+    endless C call, ``os._exit`` or segfault becomes a ``timeout`` or ``crash`` row, and a bug of
+    ours a ``bug`` row (its traceback the first of its ``notes``)."""
+    args = (str(batch_path), design_id, fusion_volume, fusion_area)
+    outcome = run_isolated(convert_design, args, timeout=timeout)
+    if outcome.ok:
+        converted: ConvertedDesign = outcome.value
+        return converted
+    path = Path(batch_path)
+    notes = [outcome.detail] if outcome.detail else []
+    return ConvertedDesign(
+        design_id,
+        path.parent.name,
+        None,
+        Status(outcome.status),
+        outcome.reason,
+        seconds=outcome.seconds,
+        notes=notes,
+    )
+
+
+def convert_batch(batch_path: str | Path, timeout: float = 120.0) -> list[ConvertedDesign]:
+    """Convert every model of a batch, in file order, each in its own killable child."""
+    path = Path(batch_path)
+    return [
+        convert_isolated(path, e.design_id, e.fusion_volume, e.fusion_area, timeout)
+        for e in batch_entries(path, path.parent.name)
+    ]

@@ -39,6 +39,7 @@ class Status(str, enum.Enum):
     NO_SHAPE = "no_shape"
     MISMATCH = "mismatch"  # our replay differs from the script's part
     FUSION_MISMATCH = "fusion_mismatch"  # the script's part differs from Fusion's figures
+    NOTHING_CONVERTED = "nothing_converted"  # convert: no design of the batches converted
 
     # the environment's fault
     TIMEOUT = "timeout"

@@ -127,6 +127,15 @@ def precise_volume(shape: TopoDS_Shape) -> float:
     return props.Mass()
 
 
+def precise_area(shape: TopoDS_Shape) -> float:
+    """An area by adaptive integration to ``VOLUME_RTOL`` (shared faces counted once). The default
+    (``surface_props``) is off by ~1e-4 on faces bounded by long high-degree splines: a corpus
+    profile measured 7.32759 whose area is 7.32685."""
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(shape, props, VOLUME_RTOL, True)
+    return props.Mass()
+
+
 def surface_props(shape: TopoDS_Shape) -> tuple[float, np.ndarray]:
     props = GProp_GProps()
     BRepGProp.SurfaceProperties_s(shape, props)

@@ -20,6 +20,6 @@ __all__ = ["corpus_shape"]
 @functools.cache
 def corpus_shape(batch: str, design_id: str) -> Shape:
     """The final shape of one corpus design (``batch`` relative to the corpus root)."""
-    converted = convert_design(CORPUS / batch, design_id, timeout_s=120)
+    converted = convert_design(CORPUS / batch, design_id)
     assert converted.ok and converted.design_json is not None, converted.reason
     return replay(parse_design(converted.design_json, design_id)).shape
