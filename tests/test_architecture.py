@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import pydoc
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -136,3 +137,18 @@ def test_every_subpackage_declares_its_api():
     for init in PACKAGE.glob("*/__init__.py"):
         names = [n for n in ast.walk(ast.parse(init.read_text())) if isinstance(n, ast.Assign)]
         assert any(t.id == "__all__" for n in names for t in n.targets if isinstance(t, ast.Name)), init
+
+
+def test_the_readme_layout_names_every_module():
+    """The README's Layout section matches the tree: every sub-package and every module of the
+    package (a sub-package's modules by their own name) is named there."""
+    readme = (PACKAGE.parent / "README.md").read_text()
+    layout = readme.split("## Layout", 1)[1].split("\n## ", 1)[0]
+    named = set(re.findall(r"`([\w/.]+?)/?`", layout))
+    missing = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE).with_suffix("").parts
+        name = parts[-2] if parts[-1] == "__init__" and len(parts) > 1 else parts[-1]
+        if name != "__init__" and name not in named and f"zonegraph/{name}" not in named:
+            missing.append("/".join(parts))
+    assert not missing, f"modules the README's Layout does not name: {missing}"
