@@ -2,7 +2,8 @@
 
 Every user-facing failure derives from :class:`ZoneGraphError`, so the CLI and the pipeline can
 turn it into a one-line message or a manifest row without a traceback, while programming errors
-(any other exception) still surface loudly.
+(any other exception) still surface loudly. OpenCASCADE's own exceptions are the third kind: the
+kernel failing on this input's geometry (:func:`is_kernel_error`), not a bug of ours.
 """
 
 from __future__ import annotations
@@ -84,3 +85,14 @@ class ReplayMismatchError(DesignError):
     """The replay ran, but its result disagrees with the design file's own ``properties``."""
 
     status = Status.REPLAY_MISMATCH
+
+
+def is_kernel_error(exc: BaseException) -> bool:
+    """Whether OpenCASCADE raised ``exc``: the one test of kernel failure versus our own bug.
+
+    OCP binds each OCCT exception class as its own subclass of ``Exception``, without OCCT's
+    hierarchy (``StdFail_NotDone``, which a Boolean or sweep not done raises, does not derive
+    from ``Standard_Failure``), so the test is where the class is defined, not its base. Such an
+    exception is a failure of the kernel on the input (e.g. ``Standard_DomainError`` from a
+    Boolean on a part at 1e12 cm); anything else is ours and keeps its traceback."""
+    return any(c.__module__.startswith("OCP") for c in type(exc).__mro__)

@@ -19,7 +19,7 @@ from multiprocessing.process import BaseProcess
 from typing import Any
 
 from zonegraph.console import captured
-from zonegraph.errors import ZoneGraphError
+from zonegraph.errors import ZoneGraphError, is_kernel_error
 from zonegraph.status import Status
 
 
@@ -39,25 +39,18 @@ class Outcome:
 def classify(exc: BaseException) -> tuple[Status, str, str]:
     """``(status, one-line reason, traceback)`` of an exception raised by a job.
 
-    OpenCASCADE's exceptions (``Standard_Failure`` and its kin, raised through OCP) are failures of
-    the kernel on this input's geometry, e.g. ``Standard_DomainError`` from a Boolean on a part at
-    1e12 cm: a status like any unbuildable input. Every other exception is a bug of ours and keeps
-    its traceback."""
+    OpenCASCADE's exceptions (:func:`zonegraph.errors.is_kernel_error`) are failures of the kernel
+    on this input's geometry: a status like any unbuildable input. Every other exception is a bug
+    of ours and keeps its traceback."""
     if isinstance(exc, ZoneGraphError):
         return exc.status, exc.explain(), ""
     last = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
     where = f" ({os.path.basename(last.filename)}:{last.lineno} {last.name})" if last else ""
     name = type(exc).__name__
     message = " ".join(str(exc).split()) or "no message"
-    if _is_kernel(exc):
+    if is_kernel_error(exc):
         return Status.KERNEL_ERROR, f"OpenCASCADE {name}: {message}{where}", ""
     return Status.BUG, f"{name}: {message}{where}", "".join(traceback.format_exception(exc))
-
-
-def _is_kernel(exc: BaseException) -> bool:
-    return any(
-        c.__module__.startswith("OCP") and c.__name__.startswith("Standard_") for c in type(exc).__mro__
-    )
 
 
 def _child(conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:

@@ -20,8 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from zonegraph.data.schema import validate_design
-from zonegraph.errors import DesignError, InputError, UnsupportedFeatureError, require_file
+from zonegraph.errors import DesignError, InputError, require_file
 from zonegraph.geometry.vec import Vec3
 
 
@@ -279,149 +278,14 @@ def parse_design(data: Any, design_id: str, source: str = "") -> Design:
     Raises:
         InputError: not a design at all; DesignError or UnsupportedFeatureError: naming the entity.
     """
+    from zonegraph.data.schema import validate_design  # here: the schema builds this module's classes
+
     name = source or design_id
     if not isinstance(data, dict) or "timeline" not in data or "entities" not in data:
         raise InputError(name, "not a Fusion 360 Gallery design (no timeline/entities)")
-    validate_design(data, name)
-    entities = data["entities"]
-    timeline: list[Entity] = []
-    for item in data["timeline"]:
-        uuid = item.get("entity") if isinstance(item, dict) else None
-        if uuid not in entities:
-            raise DesignError(name, str(uuid), "timeline names an entity that does not exist")
-        timeline.append(_parse_entity(entities[uuid], str(uuid), name))
-    design = Design(design_id, tuple(timeline), _parse_properties(data.get("properties")), source)
+    design = validate_design(data, name).to_domain(design_id, source)
     _check_references(design, name)
     return design
-
-
-def _parse_entity(e: dict, uuid: str, design: str) -> Entity:
-    kind = e.get("type")
-    try:
-        if kind == "Sketch":
-            return _parse_sketch(e, uuid, design)
-        if kind == "ExtrudeFeature":
-            return _parse_extrude(e, uuid, design)
-    except (KeyError, TypeError, ValueError) as exc:
-        raise DesignError(design, uuid, f"malformed {kind}: missing or bad field {exc}") from None
-    raise UnsupportedFeatureError(design, uuid, f"unsupported entity type {kind!r}")
-
-
-def _vec(d: dict) -> Vec3:
-    return (float(d["x"]), float(d["y"]), float(d["z"]))
-
-
-def _parse_sketch(e: dict, uuid: str, design: str) -> Sketch:
-    t = e["transform"]
-    frame = Frame(_vec(t["origin"]), _vec(t["x_axis"]), _vec(t["y_axis"]), _vec(t["z_axis"]))
-    profiles = {}
-    for pid, p in e.get("profiles", {}).items():
-        loops = tuple(
-            Loop(bool(lp["is_outer"]), tuple(_parse_curve(c, pid, design) for c in lp["profile_curves"]))
-            for lp in p["loops"]
-        )
-        area = (p.get("properties") or {}).get("area")
-        profiles[pid] = Profile(pid, loops, None if area is None else float(area))
-    return Sketch(uuid, e.get("name", ""), frame, profiles)
-
-
-def _parse_curve(c: dict, profile: str, design: str) -> Curve:
-    kind = c.get("type")
-    if kind == "Line3D":
-        return Line(_vec(c["start_point"]), _vec(c["end_point"]))
-    if kind == "Arc3D":
-        return Arc(
-            _vec(c["start_point"]),
-            _vec(c["end_point"]),
-            _vec(c["center_point"]),
-            float(c["radius"]),
-            _vec(c["normal"]),
-            float(c["start_angle"]),
-            float(c["end_angle"]),
-            _vec(c["reference_vector"]),
-        )
-    if kind == "Circle3D":
-        return Circle(_vec(c["center_point"]), float(c["radius"]), _vec(c["normal"]))
-    if kind in ("Ellipse3D", "EllipticalArc3D"):
-        common = (
-            _vec(c["center_point"]),
-            _vec(c["major_axis"]),
-            float(c["major_axis_radius"]),
-            float(c["minor_axis_radius"]),
-            _vec(c["normal"]),
-        )
-        if kind == "Ellipse3D":
-            return Ellipse(*common)
-        return EllipticalArc(*common, float(c["start_angle"]), float(c["end_angle"]))
-    if kind == "NurbsCurve3D":
-        rational = bool(c.get("rational", False))
-        return Nurbs(
-            int(c["degree"]),
-            tuple(float(k) for k in c["knots"]),
-            tuple(_vec(p) for p in c["control_points"]),
-            tuple(float(w) for w in c["weights"]) if rational else None,
-            bool(c.get("periodic", False)),
-        )
-    raise UnsupportedFeatureError(design, profile, f"unsupported curve type {kind!r}")
-
-
-def _parse_extent(d: dict) -> Extent:
-    if d.get("type", "DistanceExtentDefinition") != "DistanceExtentDefinition":
-        raise ValueError(f"extent {d.get('type')!r}")
-    taper = (d.get("taper_angle") or {}).get("value", 0.0)
-    return Extent(float(d["distance"]["value"]), float(taper))
-
-
-def _parse_extrude(e: dict, uuid: str, design: str) -> Extrude:
-    try:
-        op = Operation(e["operation"])
-    except ValueError:
-        raise UnsupportedFeatureError(design, uuid, f"unsupported operation {e['operation']!r}") from None
-    try:
-        extent_type = ExtentType(e["extent_type"])
-    except ValueError:
-        raise UnsupportedFeatureError(design, uuid, f"unsupported extent type {e['extent_type']!r}") from None
-    for key in ("extent_one", "extent_two"):
-        kind = (e.get(key) or {}).get("type", "DistanceExtentDefinition")
-        if kind != "DistanceExtentDefinition":
-            raise UnsupportedFeatureError(design, uuid, f"unsupported {key} {kind!r} (only distances)")
-    start = e.get("start_extent") or {"type": "ProfilePlaneStartDefinition"}
-    if start["type"] == "OffsetStartDefinition":
-        offset = float(start["offset"]["value"])
-    elif start["type"] == "ProfilePlaneStartDefinition":
-        offset = 0.0
-    else:
-        raise UnsupportedFeatureError(design, uuid, f"unsupported start extent {start['type']!r}")
-    two = _parse_extent(e["extent_two"]) if extent_type is ExtentType.TWO_SIDES else None
-    labels = None
-    if e.get("bodies") is not None and e.get("faces") is not None:
-        labels = StepLabels(len(e["bodies"]), len(e["faces"]))
-    return Extrude(
-        id=uuid,
-        name=e.get("name", ""),
-        profiles=tuple(ProfileRef(p["sketch"], p["profile"]) for p in e["profiles"]),
-        operation=op,
-        extent_type=extent_type,
-        extent_one=_parse_extent(e["extent_one"]),
-        extent_two=two,
-        start_offset=offset,
-        symmetric_full_length=bool(e.get("extent_one", {}).get("is_full_length", False)),
-        labels=labels,
-    )
-
-
-def _parse_properties(p: dict | None) -> DesignProperties | None:
-    if not p or p.get("volume") is None:
-        return None
-    bbox = p.get("bounding_box")
-    return DesignProperties(
-        float(p["volume"]),
-        float(p["area"]),
-        int(p.get("body_count", 1)),
-        int(p.get("face_count", 0)),
-        _vec(bbox["min_point"]) if bbox else None,
-        _vec(bbox["max_point"]) if bbox else None,
-    )
 
 
 def _check_references(design: Design, name: str) -> None:

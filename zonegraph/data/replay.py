@@ -19,7 +19,7 @@ from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 
 from zonegraph.data.design import Design, ExtentType, Extrude, Operation, Sketch
 from zonegraph.data.profiles import profile_faces
-from zonegraph.errors import DesignError, ReplayError, ZoneGraphError
+from zonegraph.errors import DesignError, ReplayError, is_kernel_error
 from zonegraph.verified import REPLAY_RTOL, Measured, disagreement, relative_difference
 
 TOUCH_TOL = 1e-6  # cm: a join tool this close to a body merges with it
@@ -168,14 +168,18 @@ def replay_extrude(
     try:
         tool = extrude_tool(extrude, sketches, where)
         after = apply_operation(bodies, tool, extrude.operation)
-    except ZoneGraphError:
-        raise
-    except Exception as exc:  # OCP's exceptions (Standard_Failure, StdFail_NotDone) share no base
-        raise ReplayError(where, extrude.id, f"OpenCASCADE failed: {type(exc).__name__}: {exc}") from None
+    except Exception as exc:
+        if not is_kernel_error(exc):
+            raise  # a ZoneGraphError already names the input; anything else is a bug of ours
+        raise _kernel_failure(where, extrude, exc) from None
     for body in after:
         if not body.is_valid:
             raise ReplayError(where, extrude.id, f"{extrude.operation.name.lower()} gave an invalid solid")
     return ReplayStep(extrude, tool, after, time.perf_counter() - t0)
+
+
+def _kernel_failure(where: str, extrude: Extrude, exc: Exception) -> ReplayError:
+    return ReplayError(where, extrude.id, f"OpenCASCADE failed: {type(exc).__name__}: {exc}")
 
 
 # --------------------------------------------------------------------------------- tool bodies
@@ -217,12 +221,18 @@ def _sweep(face: Face, normal: np.ndarray, x: Extrude, where: str) -> list[Solid
         assert x.extent_two is not None
         sides = [(x.extent_one.distance, x.extent_one.taper), (-x.extent_two.distance, x.extent_two.taper)]
     base = Pos(*(normal * s)) * face
-    return [_tapered(base, normal, d, t) for d, t in sides if abs(d) >= MIN_SPAN]
+    return [_tapered(base, normal, d, t, x, where) for d, t in sides if abs(d) >= MIN_SPAN]
 
 
-def _tapered(base: Face, normal: np.ndarray, distance: float, taper: float) -> Solid:
+def _tapered(base: Face, normal: np.ndarray, distance: float, taper: float, x: Extrude, where: str) -> Solid:
+    """The side swept with a taper. build123d offsets the profile with OpenCASCADE's 2D offset and
+    raises a plain RuntimeError when that fails ("2D offset failed", or "Unexpected result type"
+    when a steep taper splits the profile into several wires): the kernel on this geometry."""
     # Fusion's positive taper opens the profile outwards; build123d's positive taper closes it.
-    return Solid.extrude_taper(base, Vector(*(normal * distance)), -math.degrees(taper))
+    try:
+        return Solid.extrude_taper(base, Vector(*(normal * distance)), -math.degrees(taper))
+    except RuntimeError as exc:
+        raise _kernel_failure(where, x, exc) from None
 
 
 # ---------------------------------------------------------------------------------- Booleans

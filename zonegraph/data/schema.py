@@ -1,4 +1,4 @@
-"""The schema of a Fusion 360 Gallery design JSON, checked with pydantic before any geometry.
+"""The schema of a Fusion 360 Gallery design JSON: checked with pydantic, then built into the model.
 
 Only the fields that replay reads are described; everything else in a file (constraints,
 dimensions, ``sequence``, per-step face lists) passes through unchecked. A value that is present
@@ -9,8 +9,11 @@ profile loop of 4 curves does not close", a NaN distance as "extrude has zero le
 ``TypeError`` traceback.
 
 Types the replay does not support (an entity or curve ``type`` it does not know, a non-distance
-extent) are let through here, so that the parser can name them as unsupported features rather than
-as malformed input.
+extent) are let through by validation, so that building can name them as unsupported features
+rather than as malformed input.
+
+Each model builds its :mod:`zonegraph.data.design` object (``to_domain``), so the file's layout
+is described once, here: the validated tree converts itself, with no second walk over the dicts.
 """
 
 from __future__ import annotations
@@ -20,7 +23,9 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
 
-from zonegraph.errors import DesignError
+from zonegraph.data import design as domain
+from zonegraph.errors import DesignError, UnsupportedFeatureError
+from zonegraph.geometry.vec import Vec3
 
 # Centimetres. 10 km: a thousand times the largest Fusion 360 Gallery part, yet far from the
 # magnitudes (1e12) at which OpenCASCADE's Booleans fail with an empty Standard_DomainError.
@@ -46,6 +51,9 @@ class Point3D(Node):
     y: Length
     z: Length
 
+    def vec(self) -> Vec3:
+        return (self.x, self.y, self.z)
+
 
 class Vector3D(Point3D):
     """A direction: any finite vector but the zero vector, which orients nothing."""
@@ -61,11 +69,17 @@ class Line3D(Node):
     start_point: Point3D
     end_point: Point3D
 
+    def to_domain(self) -> domain.Curve:
+        return domain.Line(self.start_point.vec(), self.end_point.vec())
+
 
 class Circle3D(Node):
     center_point: Point3D
     radius: PositiveLength
     normal: Vector3D
+
+    def to_domain(self) -> domain.Curve:
+        return domain.Circle(self.center_point.vec(), self.radius, self.normal.vec())
 
 
 class Arc3D(Circle3D):
@@ -75,6 +89,18 @@ class Arc3D(Circle3D):
     end_angle: Angle
     reference_vector: Vector3D
 
+    def to_domain(self) -> domain.Curve:
+        return domain.Arc(
+            self.start_point.vec(),
+            self.end_point.vec(),
+            self.center_point.vec(),
+            self.radius,
+            self.normal.vec(),
+            self.start_angle,
+            self.end_angle,
+            self.reference_vector.vec(),
+        )
+
 
 class Ellipse3D(Node):
     center_point: Point3D
@@ -83,10 +109,30 @@ class Ellipse3D(Node):
     minor_axis_radius: PositiveLength
     normal: Vector3D
 
+    def to_domain(self) -> domain.Curve:
+        return domain.Ellipse(
+            self.center_point.vec(),
+            self.major_axis.vec(),
+            self.major_axis_radius,
+            self.minor_axis_radius,
+            self.normal.vec(),
+        )
+
 
 class EllipticalArc3D(Ellipse3D):
     start_angle: Angle
     end_angle: Angle
+
+    def to_domain(self) -> domain.Curve:
+        return domain.EllipticalArc(
+            self.center_point.vec(),
+            self.major_axis.vec(),
+            self.major_axis_radius,
+            self.minor_axis_radius,
+            self.normal.vec(),
+            self.start_angle,
+            self.end_angle,
+        )
 
 
 class NurbsCurve3D(Node):
@@ -110,11 +156,23 @@ class NurbsCurve3D(Node):
             raise ValueError(f"{len(self.weights)} weights for {len(self.control_points)} poles")
         return self
 
+    def to_domain(self) -> domain.Curve:
+        return domain.Nurbs(
+            self.degree,
+            tuple(self.knots),
+            tuple(p.vec() for p in self.control_points),
+            tuple(self.weights) if self.rational else None,
+            self.periodic,
+        )
+
 
 class OtherKind(Node):
-    """A type the replay does not know: the parser reports it as an unsupported feature."""
+    """A type the replay does not know: building reports it as an unsupported feature."""
 
     type: str
+
+    def unsupported(self, what: str, design: str, where: str) -> UnsupportedFeatureError:
+        return UnsupportedFeatureError(design, where, f"unsupported {what} {self.type!r}")
 
 
 CURVES: dict[str, type[Node]] = {
@@ -153,6 +211,15 @@ class Loop(Node):
     is_outer: bool
     profile_curves: Annotated[list[Curve], Field(min_length=1)]
 
+    def to_domain(self, profile: str, design: str) -> domain.Loop:
+        """Raises UnsupportedFeatureError (naming the profile) for a curve type we do not know."""
+        curves = []
+        for c in self.profile_curves:
+            if isinstance(c, OtherKind):
+                raise c.unsupported("curve type", design, profile)
+            curves.append(c.to_domain())
+        return domain.Loop(self.is_outer, tuple(curves))
+
 
 class ProfileProperties(Node):
     area: Measure | None = None
@@ -162,6 +229,10 @@ class Profile(Node):
     loops: Annotated[list[Loop], Field(min_length=1)]
     properties: ProfileProperties | None = None
 
+    def to_domain(self, pid: str, design: str) -> domain.Profile:
+        area = None if self.properties is None else self.properties.area
+        return domain.Profile(pid, tuple(lp.to_domain(pid, design) for lp in self.loops), area)
+
 
 class Transform(Node):
     origin: Point3D
@@ -169,11 +240,22 @@ class Transform(Node):
     y_axis: Vector3D
     z_axis: Vector3D
 
+    def to_domain(self) -> domain.Frame:
+        return domain.Frame(self.origin.vec(), self.x_axis.vec(), self.y_axis.vec(), self.z_axis.vec())
+
 
 class Sketch(Node):
     type: str
+    name: Any = ""  # a label replay never reads: kept as found, unchecked
     transform: Transform
     profiles: dict[str, Profile] = {}
+
+    def to_domain(self, uuid: str, design: str) -> domain.Sketch:
+        profiles = {pid: p.to_domain(pid, design) for pid, p in self.profiles.items()}
+        return domain.Sketch(uuid, self.name, self.transform.to_domain(), profiles)
+
+
+DISTANCE = "DistanceExtentDefinition"  # the only extent kind replay builds
 
 
 class Parameter(Node):
@@ -187,16 +269,21 @@ class AngleParameter(Node):
 class Extent(Node):
     """A distance extent; other kinds (to an object, through all) keep only their ``type``."""
 
-    type: str = "DistanceExtentDefinition"
+    type: str = DISTANCE
     distance: Parameter | None = None
     taper_angle: AngleParameter | None = None
     is_full_length: bool = False
 
     @model_validator(mode="after")
     def _distance(self) -> Extent:
-        if self.type == "DistanceExtentDefinition" and self.distance is None:
+        if self.type == DISTANCE and self.distance is None:
             raise ValueError("a distance extent needs 'distance'")
         return self
+
+    def to_domain(self) -> domain.Extent:
+        """Only for a distance extent (the extrude refuses other kinds first)."""
+        assert self.distance is not None  # _distance requires it of a distance extent
+        return domain.Extent(self.distance.value, 0.0 if self.taper_angle is None else self.taper_angle.value)
 
 
 class StartExtent(Node):
@@ -209,6 +296,15 @@ class StartExtent(Node):
             raise ValueError("an offset start needs 'offset'")
         return self
 
+    def to_offset(self, design: str, uuid: str) -> float:
+        """The start plane's offset along the normal; UnsupportedFeatureError for other starts."""
+        if self.type == "OffsetStartDefinition":
+            assert self.offset is not None  # _offset requires it
+            return self.offset.value
+        if self.type == "ProfilePlaneStartDefinition":
+            return 0.0
+        raise UnsupportedFeatureError(design, uuid, f"unsupported start extent {self.type!r}")
+
 
 class ProfileRef(Node):
     profile: str
@@ -217,6 +313,7 @@ class ProfileRef(Node):
 
 class ExtrudeFeature(Node):
     type: str
+    name: Any = ""  # a label replay never reads: kept as found, unchecked
     profiles: list[ProfileRef]
     operation: str
     extent_type: str
@@ -231,6 +328,47 @@ class ExtrudeFeature(Node):
         if self.extent_type == "TwoSidesFeatureExtentType" and self.extent_two is None:
             raise ValueError("a two-sided extrude needs 'extent_two'")
         return self
+
+    def to_domain(self, uuid: str, design: str) -> domain.Extrude:
+        """Raises UnsupportedFeatureError for an operation, extent or start replay cannot build."""
+        op, extent_type = self._kinds(uuid, design)
+        offset = 0.0 if self.start_extent is None else self.start_extent.to_offset(design, uuid)
+        two = None
+        if extent_type is domain.ExtentType.TWO_SIDES:
+            assert self.extent_two is not None  # _two_sides requires it
+            two = self.extent_two.to_domain()
+        labels = None
+        if self.bodies is not None and self.faces is not None:
+            labels = domain.StepLabels(len(self.bodies), len(self.faces))
+        return domain.Extrude(
+            id=uuid,
+            name=self.name,
+            profiles=tuple(domain.ProfileRef(p.sketch, p.profile) for p in self.profiles),
+            operation=op,
+            extent_type=extent_type,
+            extent_one=self.extent_one.to_domain(),
+            extent_two=two,
+            start_offset=offset,
+            symmetric_full_length=self.extent_one.is_full_length,
+            labels=labels,
+        )
+
+    def _kinds(self, uuid: str, design: str) -> tuple[domain.Operation, domain.ExtentType]:
+        """The operation and extent type, once both (and both extents) are kinds replay builds."""
+        try:
+            op = domain.Operation(self.operation)
+        except ValueError:
+            raise UnsupportedFeatureError(design, uuid, f"unsupported operation {self.operation!r}") from None
+        try:
+            extent_type = domain.ExtentType(self.extent_type)
+        except ValueError:
+            why = f"unsupported extent type {self.extent_type!r}"
+            raise UnsupportedFeatureError(design, uuid, why) from None
+        for key, extent in (("extent_one", self.extent_one), ("extent_two", self.extent_two)):
+            if extent is not None and extent.type != DISTANCE:
+                why = f"unsupported {key} {extent.type!r} (only distances)"
+                raise UnsupportedFeatureError(design, uuid, why)
+        return op, extent_type
 
 
 ENTITIES: dict[str, type[Node]] = {"Sketch": Sketch, "ExtrudeFeature": ExtrudeFeature}
@@ -268,22 +406,56 @@ class Properties(Node):
             raise ValueError("'volume' without 'area'")
         return self
 
+    def to_domain(self) -> domain.DesignProperties | None:
+        """None without a volume: nothing to validate a replay against."""
+        if self.volume is None:
+            return None
+        assert self.area is not None  # _area_with_volume requires it
+        box = self.bounding_box
+        return domain.DesignProperties(
+            self.volume,
+            self.area,
+            self.body_count,
+            self.face_count,
+            box.min_point.vec() if box else None,
+            box.max_point.vec() if box else None,
+        )
+
 
 class DesignFile(Node):
     timeline: list[TimelineItem]
     entities: dict[str, Entity]
     properties: Properties | None = None
 
+    def to_domain(self, design_id: str, source: str) -> domain.Design:
+        """The timeline's entities in order (entities it does not name are not built).
 
-def validate_design(data: Any, name: str) -> None:
-    """Check parsed design JSON against :class:`DesignFile`.
+        Raises:
+            DesignError: the timeline names an entity that does not exist;
+            UnsupportedFeatureError: an entity replay cannot build, named by its uuid.
+        """
+        name = source or design_id
+        timeline: list[domain.Entity] = []
+        for item in self.timeline:
+            entity = self.entities.get(item.entity)
+            if entity is None:
+                raise DesignError(name, item.entity, "timeline names an entity that does not exist")
+            if isinstance(entity, OtherKind):
+                raise entity.unsupported("entity type", name, item.entity)
+            timeline.append(entity.to_domain(item.entity, name))
+        properties = None if self.properties is None else self.properties.to_domain()
+        return domain.Design(design_id, tuple(timeline), properties, source)
+
+
+def validate_design(data: Any, name: str) -> DesignFile:
+    """Parsed design JSON checked against :class:`DesignFile`.
 
     Raises:
         DesignError: naming the first offending field by its path in the file (the entity's uuid
             in brackets), the problem and the value found, and how many other problems there are.
     """
     try:
-        DesignFile.model_validate(data)
+        return DesignFile.model_validate(data)
     except ValidationError as exc:
         errors = exc.errors(include_url=False)
         first = errors[0]
