@@ -95,8 +95,8 @@ def face_area(face: Any) -> float | None:
 
     The replay checks each rebuilt profile against this area (1e-4 relative) with build123d's
     fixed-order Gauss measure, which is off by ~1e-4 on faces bounded by long high-degree splines
-    (60730_fa513b8a_0006: 7.32759 for a face whose exact area is 7.32685). So the exact (adaptive)
-    area is stored only when the quick measure agrees with it; otherwise the check is skipped.
+    (the measured case: ``docs/results/evidence.md``). So the exact (adaptive) area is stored only
+    when the quick measure agrees with it; otherwise the check is skipped.
     """
     exact = float(precise_area(face.wrapped))
     return exact if abs(float(face.area) - exact) <= 1e-6 * abs(exact) else None

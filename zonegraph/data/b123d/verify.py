@@ -67,7 +67,7 @@ def _union_errors(union: Any, part: Any) -> tuple[float, float, str]:
     how = ""
     if dv > REPLAY_RTOL or da > REPLAY_RTOL:
         uv, pv = abs(precise_volume(union.wrapped)), abs(precise_volume(part.wrapped))
-        if uv > 0 and pv > 0:  # a broken shell (21899_d55d6c08_0024's script part) integrates to 0
+        if uv > 0 and pv > 0:  # a broken shell integrates to 0 (docs/results/evidence.md)
             dv = relative_difference(uv, pv)
             da = relative_difference(precise_area(union.wrapped), precise_area(part.wrapped))
             how = "adaptive integration"
