@@ -23,6 +23,7 @@ RANK = {
     "console": 0,
     "plugins": 0,
     "configs": 0,
+    "lazy": 0,
     "verified": 0,
     "geometry": 1,
     "data": 2,

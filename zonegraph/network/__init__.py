@@ -12,8 +12,9 @@ the ranker by reference), and this ``__init__`` imports its names on first use, 
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from zonegraph.lazy import lazy_exports
 
 _EXPORTS = {
     "ModelConfig": "zonegraph.network.model",
@@ -39,15 +40,4 @@ if TYPE_CHECKING:
     from zonegraph.network.scoring import score_state
 
 
-def __getattr__(name: str) -> Any:
-    """Import a public name from its module on first use (PEP 562): torch loads only then."""
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'zonegraph.network' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, __all__)

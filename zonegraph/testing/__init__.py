@@ -20,9 +20,9 @@ Nothing below :mod:`zonegraph.testing` imports it: it is a top layer.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from zonegraph.lazy import lazy_exports
 from zonegraph.testing.locations import (
     CORPUS,
     CORPUS_SKIP_REASON,
@@ -59,7 +59,4 @@ if TYPE_CHECKING:
     from zonegraph.testing.markers import requires_corpus, requires_samples
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    raise AttributeError(f"module 'zonegraph.testing' has no attribute {name!r}")
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY, __all__)
