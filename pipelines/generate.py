@@ -14,7 +14,6 @@
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 from typing import Any
@@ -30,6 +29,7 @@ from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import PARAMS_FILE, DaskParams, DataParams, SyntheticParams, section
+from .paths import stage_paths
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -136,10 +136,12 @@ def write_conversion(table: pd.DataFrame, out: Path, metrics_file: Path) -> None
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, required=True, help="the designs folder (index.parquet, json/)")
-    parser.add_argument("--metrics", type=Path, required=True, help="the conversion metrics JSON")
-    args = parser.parse_args()
+    args = stage_paths(
+        __doc__,
+        (),
+        out="the designs folder (index.parquet, json/)",
+        metrics="the conversion metrics JSON",
+    )
     data, dask = section(DataParams, "data"), section(DaskParams, "dask")
     source, limit = data.source, data.limit
     seed, fraction = data.split_seed, data.test_fraction

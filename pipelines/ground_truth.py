@@ -12,7 +12,6 @@ zone ids, captured and proposal count at each level, mapping check, reason),
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 
@@ -24,6 +23,7 @@ from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import DaskParams, GroundTruthParams, section
+from .paths import stage_paths
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -50,14 +50,13 @@ def designs_table(designs: Path, replayed: Path, zonegraphs: Path) -> pd.DataFra
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--designs", type=Path, required=True, help="the generate stage's folder")
-    parser.add_argument("--replay", type=Path, required=True, help="the replay stage's folder")
-    parser.add_argument("--zonegraphs", type=Path, required=True, help="the zonegraphs stage's folder")
-    parser.add_argument("--out", type=Path, required=True, help="the ground truth folder")
-    parser.add_argument("--plot", type=Path, required=True, help="the coverage plot (PNG)")
-    parser.add_argument("--metrics", type=Path, required=True, help="the coverage metrics JSON")
-    args = parser.parse_args()
+    args = stage_paths(
+        __doc__,
+        ("designs", "replay", "zonegraphs"),
+        out="the ground truth folder",
+        plot="the coverage plot (PNG)",
+        metrics="the coverage metrics JSON",
+    )
     cfg = section(GroundTruthParams, "ground_truth")
     levels = cfg.levels
     table = designs_table(args.designs, args.replay, args.zonegraphs)

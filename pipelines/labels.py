@@ -13,9 +13,7 @@ killable Dask task that writes its own shards, ``data/labels/proposals/<id>.parq
 
 from __future__ import annotations
 
-import argparse
 import json
-from pathlib import Path
 
 import pandas as pd
 
@@ -25,6 +23,7 @@ from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import DaskParams, LabelsParams, section
+from .paths import stage_paths
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -46,12 +45,12 @@ def candidates(designs: pd.DataFrame, splits: list[str], limit: int | None, seed
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--gt", type=Path, required=True, help="the ground_truth stage's folder")
-    parser.add_argument("--zonegraphs", type=Path, required=True, help="the zonegraphs stage's folder")
-    parser.add_argument("--out", type=Path, required=True, help="the labels folder (shards, records)")
-    parser.add_argument("--metrics", type=Path, required=True, help="the label metrics JSON")
-    args = parser.parse_args()
+    args = stage_paths(
+        __doc__,
+        ("gt", "zonegraphs"),
+        out="the labels folder (shards, records)",
+        metrics="the label metrics JSON",
+    )
     out, graphs = args.out, args.zonegraphs / "graphs"
     cfg = section(LabelsParams, "labels")
     level, seed = cfg.level, cfg.seed

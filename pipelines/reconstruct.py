@@ -10,10 +10,8 @@ stage saved (zone-graph build time is excluded from the budget, as in the paper)
 
 from __future__ import annotations
 
-import argparse
 import json
 from dataclasses import asdict
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -24,6 +22,7 @@ from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import DaskParams, ReconstructParams, section
+from .paths import stage_paths
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 SEARCHED = (Status.EXACT, Status.PARTIAL, Status.REBUILD_FAILED)  # a search ran and gave a program
@@ -56,12 +55,12 @@ def summarise(results: pd.DataFrame) -> dict:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--replay", type=Path, required=True, help="the replay stage's folder")
-    parser.add_argument("--zonegraphs", type=Path, required=True, help="the zonegraphs stage's folder")
-    parser.add_argument("--out", type=Path, required=True, help="the reconstructions folder")
-    parser.add_argument("--metrics", type=Path, required=True, help="the reconstruction metrics JSON")
-    args = parser.parse_args()
+    args = stage_paths(
+        __doc__,
+        ("replay", "zonegraphs"),
+        out="the reconstructions folder",
+        metrics="the reconstruction metrics JSON",
+    )
     cfg = section(ReconstructParams, "reconstruct")
     replayed = pd.read_parquet(args.replay / "manifest.parquet")
     test = replayed[(replayed["split"] == "test") & (replayed["status"] == Status.OK)]

@@ -6,7 +6,6 @@ B-reps are BREP files in the design's centimetres: ``breps/<id>/final.brep`` of 
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 
@@ -21,6 +20,7 @@ from zonegraph.verified import REPLAY_RTOL
 
 from .cluster import dask_client
 from .params import DaskParams, ReplayParams, section
+from .paths import stage_paths
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
@@ -51,11 +51,12 @@ def replay_design(path: str, out_dir: str) -> dict:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--designs", type=Path, required=True, help="the generate stage's folder")
-    parser.add_argument("--out", type=Path, required=True, help="the replay folder (manifest, breps)")
-    parser.add_argument("--metrics", type=Path, required=True, help="the replay metrics JSON")
-    args = parser.parse_args()
+    args = stage_paths(
+        __doc__,
+        ("designs",),
+        out="the replay folder (manifest, breps)",
+        metrics="the replay metrics JSON",
+    )
     cfg = section(ReplayParams, "replay")
     index = pd.read_parquet(args.designs / "index.parquet")
     code = code_fingerprint("replay")

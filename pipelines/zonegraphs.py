@@ -7,7 +7,6 @@ edges, build seconds, simplified), designs that failed to replay included with t
 
 from __future__ import annotations
 
-import argparse
 import json
 from dataclasses import asdict
 from pathlib import Path
@@ -21,15 +20,17 @@ from zonegraph.status import Status
 
 from .cluster import dask_client
 from .params import DaskParams, ZoneGraphParams, section
+from .paths import stage_paths
 from .runner import Job, code_fingerprint, fingerprint, run_jobs
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--replay", type=Path, required=True, help="the replay stage's folder")
-    parser.add_argument("--out", type=Path, required=True, help="the zone graphs folder (manifest, graphs)")
-    parser.add_argument("--metrics", type=Path, required=True, help="the zone graph metrics JSON")
-    args = parser.parse_args()
+    args = stage_paths(
+        __doc__,
+        ("replay",),
+        out="the zone graphs folder (manifest, graphs)",
+        metrics="the zone graph metrics JSON",
+    )
     cfg = section(ZoneGraphParams, "zonegraph")
     replayed = pd.read_parquet(args.replay / "manifest.parquet")
     ok = replayed[replayed["status"] == Status.OK]
