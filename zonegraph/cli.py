@@ -58,7 +58,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     check = summary.get("check")
     if check:
         print(
-            f"  vs Fusion properties: volume rel. error {check['volume_rel_error']:.1e}, "
+            f"  vs the file's properties: volume rel. error {check['volume_rel_error']:.1e}, "
             f"area rel. error {check['area_rel_error']:.1e}"
         )
     return 0

@@ -77,7 +77,7 @@ COMPLETE = {
 }
 # The command's own stdout lines on success; anything else on stdout or stderr is noise.
 OWN_LINES = {
-    "replay": (r"\S.*: \d+ extrudes, \d+ bodies, ", r"  vs Fusion properties: "),
+    "replay": (r"\S.*: \d+ extrudes, \d+ bodies, ", r"  vs the file's properties: "),
     "build": (r"\S.*: status \w+, \d+ zones ", r"  built in "),
     "infer": (r"\S.*: \w+, \d+ steps ", r"  \d+ zones, build "),
 }
