@@ -30,12 +30,19 @@ from zonegraph.jobs import convert_isolated
 THRESHOLD = 1e-6
 
 
-def _decade(x: float | None) -> str:
+def decade(x: float | None) -> str:
+    """The decade of a relative difference, as a table row key (None: not measured)."""
     if x is None:
         return "-"
     if x <= 1e-12:
         return "<= 1e-12"
     return f"1e{math.floor(math.log10(x)):d}"
+
+
+def decade_rows(volume: Counter, area: Counter) -> list[str]:
+    """Table rows, smallest decade first: how many designs differ by that much in volume, area."""
+    keys = sorted(set(volume) | set(area), key=lambda k: -99 if k.startswith("<") else int(k[2:]))
+    return [f"| {k} | {volume.get(k, 0)} | {area.get(k, 0)} |" for k in keys]
 
 
 def run(corpus: Path, per_folder: int, seed: int, work: Path) -> list[dict]:
@@ -72,10 +79,9 @@ def summarise(rows: list[dict]) -> str:
         "| relative difference, our replay vs Fusion | volume | area |",
         "|---|---|---|",
     ]
-    vol = Counter(_decade(r["fusion_volume_rel_difference"]) for r in ok)
-    area = Counter(_decade(r["fusion_area_rel_difference"]) for r in ok)
-    for key in sorted(set(vol) | set(area), key=lambda k: -99 if k.startswith("<") else -int(k[3:] or 99)):
-        lines.append(f"| {key} | {vol.get(key, 0)} | {area.get(key, 0)} |")
+    vol = Counter(decade(r["fusion_volume_rel_difference"]) for r in ok)
+    area = Counter(decade(r["fusion_area_rel_difference"]) for r in ok)
+    lines += decade_rows(vol, area)
     above = [
         r
         for r in ok
