@@ -104,3 +104,39 @@ def test_classes_of_made_up_runs(tmp_path):
     got = {name: _classified(tmp_path / name, **kw) for name, kw in cases.items()}
     assert {name: outcome for name, (outcome, _) in got.items()} == expected
     assert got["all_at_once"][1] == ["traceback", "noise", "partial_output"]
+
+
+PROBE = '''
+PROBE = ("a-literal-no-module-had", 987654, 31337, 7, 12, b"zz", -3, 2.5)
+'''
+
+DRAW = """
+import hashlib, sys
+sys.path.insert(0, sys.argv[1])
+if len(sys.argv) > 2:
+    import probe  # a local module with literals of its own
+from zonegraph.testing import fuzz
+cases = fuzz.draw_cases(200, 0, fuzz.fuzz_cases({}))
+print(hashlib.sha1("\\n".join(c.label() for c in cases).encode()).hexdigest())
+"""
+
+
+@requires_samples
+def test_the_drawn_inputs_depend_on_the_seed_alone(tmp_path):
+    """Hypothesis mixes the literals of every loaded local module into its draws; the harness must
+    not, so that a change of the project's code never changes the fuzz inputs (a before/after pair
+    of runs compares input by input)."""
+    (tmp_path / "probe.py").write_text(PROBE)
+
+    def digest(*extra: str) -> str:
+        proc = subprocess.run(
+            [sys.executable, "-c", DRAW, str(tmp_path), *extra],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            timeout=300,
+            check=True,
+        )
+        return proc.stdout.strip()
+
+    assert digest() == digest("with the probe module")
