@@ -3,7 +3,7 @@
     python -m bench.corpus_bench [--per-folder 25] [--budget 20] [--seed 0] [--workers 2]
                                  [--guide heuristic|random|net] [--model PATH]
                                  [--index data/designs/index.parquet --split test]
-                                 [--fresh-from 0]
+                                 [--fresh-from 0] [--against OLD/results.json]
                                  [--corpus ../shared/data/fusion360_b123d] [--out bench_out/corpus]
 
 A seeded sample with the same number of designs from every timeline folder of the build123d corpus
@@ -18,7 +18,9 @@ designs it never saw. ``--fresh-from T`` draws only among the designs that the s
 did not draw: the tuning sample is seed 0 (every change of the core is measured on it), the
 validation sample is ``--seed 2023 --fresh-from 0``, a seed never used for tuning, so its figures
 come from parts that did not steer the work. A folder smaller than two samples (``08_21plus`` has
-15 designs) has no fresh designs left; the table shows it with 0 designs.
+15 designs) has no fresh designs left; the table shows it with 0 designs. ``--against`` names the
+``results.json`` of an earlier run of the same sample and lists every design exact there and not
+now, and the reverse.
 """
 
 from __future__ import annotations
@@ -148,6 +150,20 @@ def budget_and_rebuild(rows: list[dict]) -> list[str]:
     return lines
 
 
+def changes(before: list[dict], after: list[dict]) -> list[str]:
+    """The designs exact in one run of a sample and not in the other."""
+    was = {r["design_id"]: bool(r.get("exact")) for r in before}
+    now = {r["design_id"]: bool(r.get("exact")) for r in after}
+    common = sorted(was.keys() & now.keys())
+    lost = [d for d in common if was[d] and not now[d]]
+    won = [d for d in common if now[d] and not was[d]]
+    return [
+        f"- against the earlier run ({len(common)} designs in both): exact before and not now: "
+        f"{len(lost)}{(' (' + ', '.join(lost) + ')') if lost else ''}; "
+        f"exact now and not before: {len(won)}{(' (' + ', '.join(won) + ')') if won else ''}"
+    ]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--corpus", type=Path, default=CORPUS)
@@ -160,6 +176,7 @@ def main() -> None:
     parser.add_argument("--model", default=None, help="the net guide's checkpoint (default: shipped)")
     parser.add_argument("--index", type=Path, default=None, help="a run's data/designs/index.parquet")
     parser.add_argument("--split", default="test", help="the split of --index to draw from")
+    parser.add_argument("--against", type=Path, default=None, help="an earlier run's results.json")
     parser.add_argument(
         "--fresh-from", type=int, default=None, help="leave out the designs the sample of this seed draws"
     )
@@ -178,7 +195,10 @@ def main() -> None:
         rows = run_designs(
             _job, jobs, args.workers, lambda rs: f", {sum(bool(r.get('exact')) for r in rs)} exact"
         )
-    write_results(rows, summarise(rows), args.out)
+    text = summarise(rows)
+    if args.against:
+        text += "\n\n" + "\n".join(changes(json.loads(args.against.read_text()), rows))
+    write_results(rows, text, args.out)
 
 
 if __name__ == "__main__":
