@@ -25,6 +25,7 @@ from functools import cached_property
 
 import numpy as np
 
+from zonegraph.sequence.deadline import Deadline
 from zonegraph.zones.model import ZoneGraph
 
 PARALLEL_TOL = 1e-9
@@ -306,8 +307,11 @@ class ProposalGenerator:
             volume |= swept
         return volume
 
-    def _candidates(self, s: int, e: int, mask: np.ndarray) -> _Candidates:
-        """The sketches of the faces ``mask`` selects on plane s, swept to e (memoised).
+    def _candidates(
+        self, s: int, e: int, mask: np.ndarray, deadline: Deadline | None = None
+    ) -> _Candidates | None:
+        """The sketches of the faces ``mask`` selects on plane s, swept to e (memoised), or None
+        when ``deadline`` passes first (an unfinished group is not memoised).
 
         A group's candidates depend only on which faces are in it, not on the rest of the
         canvas, and the same groups recur across the canvases of a search and of random
@@ -317,6 +321,8 @@ class ProposalGenerator:
         if hit is None:
             volumes, union, subtract = [], [], []
             for sketch in self.sketches(self.faces_on[s][mask], s):
+                if deadline is not None and deadline.passed():
+                    return None
                 volume = self.extrusion(sketch, s, e)
                 if volume is None or not volume.any():
                     continue
@@ -327,8 +333,9 @@ class ProposalGenerator:
             hit = self._groups[key] = _Candidates(matrix, tuple(union), tuple(subtract))
         return hit
 
-    def proposals(self, canvas: np.ndarray) -> list[Proposal]:
-        """Every distinct (volume, operation) reachable from ``canvas`` by one extrusion.
+    def proposals(self, canvas: np.ndarray, deadline: Deadline | None = None) -> list[Proposal]:
+        """Every distinct (volume, operation) reachable from ``canvas`` by one extrusion; once
+        ``deadline`` passes, those of the face groups finished by then (a search stops anyway).
 
         Shapes:
             canvas: (Z,) bool. A union is proposed when the volume has zones outside the canvas,
@@ -347,7 +354,9 @@ class ProposalGenerator:
             a, b = self._starts[i], self._ends[i]
             for g, mask in enumerate(groups):
                 if filled[g][i]:
-                    cand = self._candidates(s, e, mask[a:b])
+                    cand = self._candidates(s, e, mask[a:b], deadline)
+                    if cand is None:
+                        return self._distinct(found, canvas) if found else []
                     if cand.union:
                         found.append(cand)
         if not found:
