@@ -349,7 +349,7 @@ class ProposalGenerator:
         )
         counts = [np.concatenate(([0], np.cumsum(g))) for g in groups]
         filled = [c[self._ends] > c[self._starts] for c in counts]  # a group has faces on the pair
-        found = []
+        found: list[_Candidates] = []
         for i, (s, e) in enumerate(self.pairs):
             a, b = self._starts[i], self._ends[i]
             for g, mask in enumerate(groups):
