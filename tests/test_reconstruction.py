@@ -139,6 +139,8 @@ def test_cli_infer_writes_result(samples_dir, tmp_path):
         "time_to_best_s",
         "build_s",
         "search_s",
+        "rebuild_s",
+        "verify_s",
         "zones",
         "expansions",
     }

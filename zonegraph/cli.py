@@ -201,7 +201,8 @@ def _cmd_infer(args: argparse.Namespace) -> int:
     )
     print(
         f"  {r.zones} zones, build {r.build_s:.2f} s, search {r.search_s:.2f} s "
-        f"(best after {r.time_to_best_s:.2f} s, {r.expansions} expansions) -> {args.out}"
+        f"(best after {r.time_to_best_s:.2f} s, {r.expansions} expansions), "
+        f"rebuild {r.rebuild_s:.2f} s, verify {r.verify_s:.2f} s -> {args.out}"
     )
     return 0
 

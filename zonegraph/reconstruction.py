@@ -4,7 +4,8 @@ The simplified zone graph is searched first (fewer zones, faster); if it yields 
 the unsimplified graph gets the rest of the budget (face-loop strips can leave zones that no prism
 fills, as on slanted walls), unless simplification found no face loop and the two graphs are one.
 The best program found is rebuilt from its sketches and measured against the target with B-rep
-Booleans, whether or not it is exact.
+Booleans, whether or not it is exact. The budget bounds the search alone, each graph's proposal
+generator set-up included; building the graphs, rebuilding and verifying are timed apart.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from zonegraph.data.targets import load_target
 from zonegraph.export.verify import Export, verified_export
 from zonegraph.export.writers import write_outputs
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
+from zonegraph.sequence.deadline import Deadline
 from zonegraph.sequence.program import RebuildError, brep_iou, build_program, execute
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
@@ -44,7 +46,7 @@ class Reconstruction:
     generator: ProposalGenerator
     result: SearchResult
     build_s: float  # zone-graph build seconds (both graphs)
-    search_s: float  # search seconds (both graphs)
+    search_s: float  # search seconds (both graphs, generator set-up included)
     solids: list[Solid]  # the target, in the input's units
     trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
 
@@ -65,7 +67,7 @@ class InferResult:
     steps: int
     time_to_best_s: float  # search seconds to the returned program (both graphs)
     build_s: float
-    search_s: float
+    search_s: float  # both graphs, generator set-up included: what the budget bounds
     zones: int
     simplified: bool
     expansions: int
@@ -77,6 +79,8 @@ class InferResult:
     operations: list[str] = field(default_factory=list)  # union / subtract, in program order
     step_zones: list[list[int]] = field(default_factory=list)  # each step's extrusion zones (its graph)
     rebuild_error: str = ""
+    rebuild_s: float = 0.0  # rebuilding the program and its B-rep IoU against the target
+    verify_s: float = 0.0  # snapping, checking and writing the script and JSON
     config: dict[str, Any] = field(default_factory=dict)
     trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
 
@@ -144,14 +148,16 @@ def reconstruct(
             error = exc
             continue
         build_s += seconds
-        left = config.budget_s - search_s
+        share = (config.budget_s - search_s) * budget_share(graph, simplify)
+        deadline = Deadline.after(share)  # the generator's set-up counts against the budget
         gen = ProposalGenerator(graph, level=config.level)
-        settings = {**asdict(config), "budget_s": left * budget_share(graph, simplify)}
-        result = search(graph, ranker, SearchConfig.from_mapping(settings), gen)
+        setup = share - deadline.left()
+        settings = {**asdict(config), "budget_s": share - setup}
+        result = search(graph, ranker, SearchConfig.from_mapping(settings), gen, deadline)
         if best is None or (result.iou, -len(result.steps)) > (best[2].iou, -len(best[2].steps)):
-            trace += _improvements(result, search_s, best[2].iou if best else -1.0)
+            trace += _improvements(result, search_s + setup, best[2].iou if best else -1.0)
             best = (graph, gen, result)
-        search_s += result.seconds
+        search_s += setup + result.seconds
         if result.exact or not graph.surface_strip.any():  # no face loop: the full graph is the same
             break
     if best is None:
@@ -221,6 +227,7 @@ def infer(
     target = as_shape(rec.solids)
     states: list = []
     rebuild_error, iou = "", 0.0
+    started = time.perf_counter()
     try:
         states = execute(program)
         iou = brep_iou(states[-1] if states else None, target)
@@ -228,11 +235,13 @@ def infer(
         rebuild_error = str(exc)
     if not rebuild_error and rec.result.exact and iou < EXACT_IOU:
         rebuild_error = _disagreement(states[-1] if states else None, target, iou)
+    rebuild_s = time.perf_counter() - started
     export: Export | None = None
     if states:
         unit = input_unit(path)
         export = verified_export(program, path.stem, unit, target, iou, EXACT_IOU)
         write_outputs(export.script, export.design, program, states, out_dir, unit, render)
+    verify_s = time.perf_counter() - started - rebuild_s
     exact = bool(iou >= EXACT_IOU)  # the rebuilt B-rep decides, not the zones it was found on
     result = InferResult(
         status=Status.REBUILD_FAILED if rebuild_error else Status.EXACT if exact else Status.PARTIAL,
@@ -250,6 +259,8 @@ def infer(
         operations=[s.op.name.lower() for s in program],
         step_zones=[[int(z) for z in np.flatnonzero(p.zones)] for p in rec.result.steps],
         rebuild_error=rebuild_error,
+        rebuild_s=rebuild_s,
+        verify_s=verify_s,
         config=asdict(config),
         trace=rec.trace,
     )

@@ -5,7 +5,9 @@ proposals are scored at once by a ranker, the top k are kept (k may shrink with 
 paper's 15 - 0.5 per level), the best is explored first, and a dead end (no proposal, depth limit,
 a canvas seen before) backs up to the next of the top k. The search stops when the canvas equals
 the target or a budget (wall clock, expansions) is spent, and returns the best canvas seen: highest
-zone IoU, then fewest steps. The anytime trace of (seconds, best IoU) feeds IoU-vs-time curves.
+zone IoU, then fewest steps. The wall clock is a :class:`Deadline` that proposal generation checks
+too, since one expansion of a graph of thousands of zones can outlast the whole budget. The
+anytime trace of (seconds, best IoU) feeds IoU-vs-time curves.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from zonegraph.configs import Config
+from zonegraph.sequence.deadline import Deadline
 from zonegraph.sequence.proposals import Proposal, ProposalGenerator
 from zonegraph.sequence.rankers import Ranker, zone_iou
 from zonegraph.zones.model import ZoneGraph
@@ -81,6 +84,7 @@ def search(
     ranker: Ranker,
     config: SearchConfig = SearchConfig(),
     generator: ProposalGenerator | None = None,
+    deadline: Deadline | None = None,
 ) -> SearchResult:
     """Find a proposal sequence whose canvas equals the target's zones (best-first, top-k).
 
@@ -90,11 +94,16 @@ def search(
         config: width, depth and budget.
         generator: a proposal generator to reuse (its memoised sweeps carry over); by default a
             new level-1 generator.
+        deadline: when the search stops, checked between and within expansions; by default
+            ``config.budget_s`` from now (a caller passes one to count work done before, such
+            as building the generator, against the budget).
 
     Returns:
         The best canvas seen (highest zone IoU, then fewest steps), exact or not, with the anytime
         trace and per-expansion statistics.
     """
+    if deadline is None:
+        deadline = Deadline.after(config.budget_s)
     gen = generator or ProposalGenerator(graph)
     target = graph.zone_inside.astype(bool)
     t0 = time.perf_counter()
@@ -109,10 +118,10 @@ def search(
     def expand(canvas: np.ndarray, path: list[Proposal]) -> Iterator[Proposal]:
         start = time.perf_counter()
         used = {p.inverse_key for p in path}
-        props = [p for p in gen.proposals(canvas) if p.key not in used]
+        props = [p for p in gen.proposals(canvas, deadline) if p.key not in used]
         counts.append(len(props))
         order: list[int] = []
-        if props:
+        if props and not deadline.passed():  # past it, the search stops: nothing to score for
             scores = np.asarray(ranker.score(graph, canvas, props), float)
             order = np.argsort(-scores, kind="stable")[: config.k_at(len(path))].tolist()
         times.append(time.perf_counter() - start)
@@ -121,8 +130,7 @@ def search(
     stack = [_Frame(empty, [], expand(empty, []))]
     exact = bool(np.array_equal(empty, target))
     while stack and not exact:
-        elapsed = time.perf_counter() - t0
-        if elapsed > config.budget_s or (config.max_expansions and len(counts) >= config.max_expansions):
+        if deadline.passed() or (config.max_expansions and len(counts) >= config.max_expansions):
             break
         frame = stack[-1]
         child = next(frame.children, None)

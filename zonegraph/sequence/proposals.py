@@ -25,6 +25,7 @@ from functools import cached_property
 
 import numpy as np
 
+from zonegraph.sequence.deadline import Deadline
 from zonegraph.zones.model import ZoneGraph
 
 PARALLEL_TOL = 1e-9
@@ -117,6 +118,11 @@ class ProposalGenerator:
         self._links_on = self._links_by_plane(planes)
         self._zone_faces = self._faces_of_zones()
         self._sweeps: dict[tuple[int, int, int], np.ndarray | None] = {}
+        self._face_zone_list = [tuple(pair) for pair in graph.face_zones.tolist()]
+        self._face_surface_list = graph.face_surface.tolist()
+        self._zone_face_lists = [faces.tolist() for faces in self._zone_faces]
+        self._side_lists: dict[int, list[int]] = {}
+        self._crossed: dict[tuple[int, int], tuple[list[bool], list[bool]]] = {}
         self._groups: dict[tuple[int, int, bytes], _Candidates] = {}
         self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
         self._flatten_pairs()
@@ -196,25 +202,30 @@ class ProposalGenerator:
         start = b if float(g.face_normal[face] @ d) > 0 else a
         if start < 0:
             return None
-        zones = np.zeros(g.n_zones, bool)
+        on_s, on_e = self._sides(s), self._sides(e)
+        crossed_from_a, crossed_from_b = self._crossings(s, e)
+        face_zones, face_surface = self._face_zone_list, self._face_surface_list
+        seen = bytearray(g.n_zones)
         stack = [int(start)]
         while stack:
             z = stack.pop()
-            if zones[z]:
+            if seen[z]:
                 continue
-            if g.plane_side[s, z] != side_s or g.plane_side[e, z] != -side_e:
+            if on_s[z] != side_s or on_e[z] != -side_e:
                 return None  # the zone reaches outside the slab between s and e
-            zones[z] = True
-            for f in self._zone_faces[z]:
-                if g.face_surface[f] == e:
+            seen[z] = 1
+            for f in self._zone_face_lists[z]:
+                if face_surface[f] == e:
                     continue
-                fa, fb = g.face_zones[f]
-                if not self._crossed(f, fa == z, d, length):
+                fa, fb = face_zones[f]
+                from_first = fa == z
+                if not (crossed_from_a[f] if from_first else crossed_from_b[f]):
                     continue
-                other = fb if fa == z else fa
+                other = fb if from_first else fa
                 if other < 0:
                     return None
-                stack.append(int(other))
+                stack.append(other)
+        zones = np.frombuffer(bytes(seen), np.uint8).astype(bool)
         if (
             abs(float(g.zone_volume[zones].sum()) - g.face_area[face] * length)
             > PRISM_RTOL * g.face_area[face] * length
@@ -222,18 +233,34 @@ class ProposalGenerator:
             return None
         return zones
 
-    def _crossed(self, face: int, from_first: bool, d: np.ndarray, length: float) -> bool:
-        """Whether a sweep along ``d`` goes on through ``face`` out of the zone it is in (the
-        face's first zone when ``from_first``): a planar face when it faces along d (a cap); a
-        curved face unless it lies on a cylinder or extrusion along d (a side wall)."""
-        n = self.graph.face_normal[face]
-        if np.isfinite(n[0]):
-            outward = n if from_first else -n  # face normals point from zone a to zone b
-            return float(outward @ d) > PARALLEL_TOL * length
-        surface = int(self.graph.face_surface[face])
-        if surface < 0 or self.graph.surface_kind[surface] not in SIDE_WALL_KINDS:
-            return True
-        return 1 - abs(float(self.graph.surface_axis[surface, 3:] @ d)) / length >= PARALLEL_TOL
+    def _sides(self, plane: int) -> list[int]:
+        """Each zone's side of a plane (``plane_side`` row) as a list: a sweep reads it zone by
+        zone, and indexing a NumPy row one zone at a time dominated a sweep's cost."""
+        if plane not in self._side_lists:
+            self._side_lists[plane] = self.graph.plane_side[plane].tolist()
+        return self._side_lists[plane]
+
+    def _crossings(self, s: int, e: int) -> tuple[list[bool], list[bool]]:
+        """For every face, whether a sweep along d (from s to e) goes on through it out of its
+        first zone, and out of its second (memoised per plane pair): a planar face when it faces
+        along d (a cap); a curved face unless it lies on a cylinder or extrusion along d (a side
+        wall). Classifying all faces at once replaced a per-face test that was half a sweep's
+        cost on graphs of thousands of zones."""
+        key = (s, e)
+        if key not in self._crossed:
+            g = self.graph
+            d = self.direction(s, e)
+            length = float(np.linalg.norm(d))
+            planar = np.isfinite(g.face_normal[:, 0])
+            along = np.where(planar[:, None], g.face_normal, 0.0) @ d  # face normals point a -> b
+            surface = g.face_surface
+            wall = (surface >= 0) & np.isin(g.surface_kind[np.maximum(surface, 0)], SIDE_WALL_KINDS)
+            axis = g.surface_axis[np.maximum(surface, 0), 3:] @ d
+            curved = ~wall | (1 - np.abs(axis) / length >= PARALLEL_TOL)
+            from_a = np.where(planar, along > PARALLEL_TOL * length, curved)
+            from_b = np.where(planar, -along > PARALLEL_TOL * length, curved)
+            self._crossed[key] = (from_a.tolist(), from_b.tolist())
+        return self._crossed[key]
 
     # ------------------------------------------------------------------------ proposals
 
@@ -280,8 +307,11 @@ class ProposalGenerator:
             volume |= swept
         return volume
 
-    def _candidates(self, s: int, e: int, mask: np.ndarray) -> _Candidates:
-        """The sketches of the faces ``mask`` selects on plane s, swept to e (memoised).
+    def _candidates(
+        self, s: int, e: int, mask: np.ndarray, deadline: Deadline | None = None
+    ) -> _Candidates | None:
+        """The sketches of the faces ``mask`` selects on plane s, swept to e (memoised), or None
+        when ``deadline`` passes first (an unfinished group is not memoised).
 
         A group's candidates depend only on which faces are in it, not on the rest of the
         canvas, and the same groups recur across the canvases of a search and of random
@@ -291,6 +321,8 @@ class ProposalGenerator:
         if hit is None:
             volumes, union, subtract = [], [], []
             for sketch in self.sketches(self.faces_on[s][mask], s):
+                if deadline is not None and deadline.passed():
+                    return None
                 volume = self.extrusion(sketch, s, e)
                 if volume is None or not volume.any():
                     continue
@@ -301,8 +333,9 @@ class ProposalGenerator:
             hit = self._groups[key] = _Candidates(matrix, tuple(union), tuple(subtract))
         return hit
 
-    def proposals(self, canvas: np.ndarray) -> list[Proposal]:
-        """Every distinct (volume, operation) reachable from ``canvas`` by one extrusion.
+    def proposals(self, canvas: np.ndarray, deadline: Deadline | None = None) -> list[Proposal]:
+        """Every distinct (volume, operation) reachable from ``canvas`` by one extrusion; once
+        ``deadline`` passes, those of the face groups finished by then (a search stops anyway).
 
         Shapes:
             canvas: (Z,) bool. A union is proposed when the volume has zones outside the canvas,
@@ -316,12 +349,14 @@ class ProposalGenerator:
         )
         counts = [np.concatenate(([0], np.cumsum(g))) for g in groups]
         filled = [c[self._ends] > c[self._starts] for c in counts]  # a group has faces on the pair
-        found = []
+        found: list[_Candidates] = []
         for i, (s, e) in enumerate(self.pairs):
             a, b = self._starts[i], self._ends[i]
             for g, mask in enumerate(groups):
                 if filled[g][i]:
-                    cand = self._candidates(s, e, mask[a:b])
+                    cand = self._candidates(s, e, mask[a:b], deadline)
+                    if cand is None:
+                        return self._distinct(found, canvas) if found else []
                     if cand.union:
                         found.append(cand)
         if not found:
