@@ -7,7 +7,7 @@ import pytest
 from zonegraph.testing import requires_corpus
 from zonegraph.testing.corpus import corpus_shape
 from zonegraph.zones.build import build_zone_graph
-from zonegraph.zones.model import BOX_VOLUME_RTOL, MESH_BOX_RTOL
+from zonegraph.zones.model import BOX_VOLUME_RTOL, MESH_BOX_RTOL, TARGET_VOLUME_RTOL
 
 pytestmark = requires_corpus
 
@@ -32,3 +32,14 @@ def test_the_volume_maker_splits_a_box_the_general_fuse_left_whole():
 def test_a_zone_thinner_than_the_mesh_chord_gets_an_interior_point():
     graph = build_zone_graph(corpus_shape("03_4to5ops/batch_001.py", "119890_6068cfe4_0000"), samples=0)
     assert graph.n_zones > 100  # check() passed: every zone has a verified interior point
+
+
+def test_zones_the_solid_classifier_mislabels_at_an_extruded_wall_are_labelled_on_the_meshes():
+    """A closed profile extruded (one surface of extrusion, two caps) in a box of three zones: the
+    solid classifier says IN at the left outside zone's centroid, for that zone and for the target
+    alike, so the inside zones held 1.137 of the target; on the meshes the left and right zones
+    are outside, as their symmetry requires."""
+    graph = build_zone_graph(corpus_shape("05_8to10ops/batch_010.py", "67572_05561813_0000"), samples=0)
+    assert graph.zone_volume.sum() / graph.box_volume == pytest.approx(1, abs=BOX_VOLUME_RTOL)
+    assert graph.inside_volume / graph.target_volume == pytest.approx(1, abs=TARGET_VOLUME_RTOL)
+    assert graph.n_zones == 3 and int(graph.zone_inside.sum()) == 1
