@@ -27,7 +27,7 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_VERTEX
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
 from zonegraph.geometry.occ import direction, pnt, shape_index, sub_shapes, surface_props, xyz
-from zonegraph.zones.face_loops import find_face_loops
+from zonegraph.zones.face_loops import LoopRule, find_face_loops
 
 GEOM_TOL = 1e-7  # normalised units: surfaces closer than this are the same surface
 PARALLEL_TOL = 1e-9  # 1 - |cos| for parallel directions
@@ -218,14 +218,18 @@ def _merge(intervals: list[tuple[float, float]]) -> list[tuple[float, float]]:
 
 
 def extend_faces(
-    target: TopoDS_Shape, box: np.ndarray, simplify: bool = True, min_area_fraction: float = 1e-7
+    target: TopoDS_Shape,
+    box: np.ndarray,
+    rule: LoopRule | None = LoopRule.STRICT,
+    min_area_fraction: float = 1e-7,
 ) -> tuple[list[ExtendedSurface], int]:
-    """Distinct extended surfaces of ``target`` (box planes first) and the number of target faces."""
+    """Distinct extended surfaces of ``target`` (box planes first) and the number of target faces;
+    ``rule``: which faces may be face-loop walls (``None``: no simplification, every plane whole)."""
     faces = [TopoDS.Face(f) for f in _distinct_faces(target)]
     areas = [surface_props(f)[0] for f in faces]
     min_area = min_area_fraction * sum(areas)
     ext = _Extender(box)
-    loops = find_face_loops(faces) if simplify else None
+    loops = find_face_loops(faces, rule) if rule is not None else None
     planes: dict[int, ExtendedSurface] = {}
     for i, (face, area) in enumerate(zip(faces, areas, strict=False)):
         if area < min_area:
@@ -251,6 +255,18 @@ def extend_faces(
     for s in planes.values():
         ext.plane_sheets(s, faces, loops)
     return ext.surfaces, len(faces)
+
+
+def same_extension(a: list[ExtendedSurface], b: list[ExtendedSurface]) -> bool:
+    """Whether two extensions of one target give every surface the same strips (the same sheets)."""
+    return len(a) == len(b) and all(_same_strips(s.strips, t.strips) for s, t in zip(a, b, strict=True))
+
+
+def _same_strips(a: list[tuple[np.ndarray, float, float]], b: list[tuple[np.ndarray, float, float]]) -> bool:
+    return len(a) == len(b) and all(
+        parallel(d, e) and abs(a0 - b0) < GEOM_TOL and abs(a1 - b1) < GEOM_TOL
+        for (d, a0, a1), (e, b0, b1) in zip(a, b, strict=True)
+    )
 
 
 def _distinct_faces(shape: TopoDS_Shape) -> list[TopoDS_Shape]:

@@ -1,19 +1,30 @@
 """Face loops (paper sec. 3, supplement A): the side walls of an extrusion.
 
-A face loop is a cycle of faces in which consecutive faces share an edge, all those shared edges are
-parallel (the loop's extrusion direction) and every face has exactly four edges in its outer wire.
-Planar faces with a curved edge are caps ("frames"), not walls, so they stop a loop. Walls only need
-extending along their extrusion direction, which keeps the zone count down.
+A face loop is a cycle of faces in which consecutive faces share an edge and all those shared edges
+are parallel (the loop's extrusion direction). Walls only need extending along their extrusion
+direction, which keeps the zone count down. Which faces may be walls is a rule:
+
+- ``STRICT``: every face has exactly four edges in its outer wire, and a planar one only straight
+  ones (planar faces with a curved edge are caps, "frames", and stop a loop).
+- ``LOOSE``: curved walls (cylinders, extrusions) with any number of outer edges, as in the
+  original implementation, and planar walls whose straight outer edges make four sides, some split
+  where another face meets them. A planar face with more sides stays a cap: it is an extrusion's
+  profile, and taking it as a wall crosses its loop's walls with a second strip (more zones). The
+  looser rule's loops include the strict ones.
+
+The looser rule's strips can leave a partition that misses part of the target, so the build checks
+its graph and falls back to the strict rule (``zonegraph.zones.build``).
 """
 
 from __future__ import annotations
 
+import enum
 from collections import defaultdict
 
 import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
-from OCP.BRepTools import BRepTools
+from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
 from OCP.GeomAbs import GeomAbs_Line, GeomAbs_Plane
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
@@ -21,6 +32,15 @@ from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 from zonegraph.geometry.occ import ShapeIndex, make_compound, shape_index, sub_shapes, xyz
 
 PARALLEL_TOL = 1e-9  # 1 - |cos| between edge directions
+
+Loops = dict[int, list[np.ndarray]]
+
+
+class LoopRule(str, enum.Enum):
+    """Which faces may be walls of a face loop."""
+
+    LOOSE = "loose"
+    STRICT = "strict"
 
 
 def _line_direction(edge: TopoDS_Shape) -> np.ndarray | None:
@@ -31,16 +51,43 @@ def _line_direction(edge: TopoDS_Shape) -> np.ndarray | None:
     return d / np.linalg.norm(d)
 
 
-def _is_wall_candidate(face: TopoDS_Face, directions: list[np.ndarray | None]) -> bool:
-    """Four outer edges; a planar face must have only straight ones."""
-    if len(directions) != 4:
-        return False
+def _is_wall_candidate(face: TopoDS_Face, directions: list[np.ndarray | None], rule: LoopRule) -> bool:
+    """Whether a face with these outer-edge directions (``None``: curved) may be a wall."""
     planar = BRepAdaptor_Surface(face).GetType() == GeomAbs_Plane
-    return not planar or all(d is not None for d in directions)
+    if planar and any(d is None for d in directions):
+        return False
+    if rule is LoopRule.STRICT:
+        return len(directions) == 4
+    return not planar or _sides(face) == 4
 
 
-def find_face_loops(faces: list[TopoDS_Face]) -> dict[int, list[np.ndarray]]:
+def _sides(face: TopoDS_Face) -> int:
+    """The number of sides of a face's outer wire of straight edges: runs of collinear edges in
+    wire order count once."""
+    explorer = BRepTools_WireExplorer(BRepTools.OuterWire_s(face), face)
+    dirs = []
+    while explorer.More():
+        d = _line_direction(explorer.Current())
+        if d is not None:
+            dirs.append(d)
+        explorer.Next()
+    turns = [1 - abs(float(a @ b)) >= PARALLEL_TOL for a, b in zip(dirs, dirs[1:] + dirs[:1], strict=True)]
+    return sum(turns)
+
+
+def find_face_loops(faces: list[TopoDS_Face], rule: LoopRule = LoopRule.STRICT) -> Loops:
     """For each face index in a loop, the extrusion directions of the loops it belongs to."""
+    loops = _loops_of(faces, rule)
+    if rule is LoopRule.LOOSE:
+        # A looser wall can join a strict loop's component with a third link and so hide that
+        # cycle; the strict loops are added back so the looser rule never finds fewer.
+        for f, dirs in _loops_of(faces, LoopRule.STRICT).items():
+            have = loops.setdefault(f, [])
+            have.extend(d for d in dirs if not any(1 - abs(float(d @ h)) < PARALLEL_TOL for h in have))
+    return loops
+
+
+def _loops_of(faces: list[TopoDS_Face], rule: LoopRule) -> Loops:
     edge_faces: dict[int, list[int]] = defaultdict(list)  # edge id -> candidate faces
     edge_dir: dict[int, np.ndarray] = {}
     all_edges = shape_index_of(faces)
@@ -48,7 +95,7 @@ def find_face_loops(faces: list[TopoDS_Face]) -> dict[int, list[np.ndarray]]:
         outer = BRepTools.OuterWire_s(face)
         edges = sub_shapes(outer, TopAbs_EDGE) if not outer.IsNull() else []
         dirs = [_line_direction(e) for e in edges]
-        if not _is_wall_candidate(face, dirs):
+        if not _is_wall_candidate(face, dirs, rule):
             continue
         for e, d in zip(edges, dirs, strict=False):
             if d is None:
@@ -56,8 +103,9 @@ def find_face_loops(faces: list[TopoDS_Face]) -> dict[int, list[np.ndarray]]:
             eid = all_edges.FindIndex(e)
             edge_faces[eid].append(i)
             edge_dir[eid] = d
-    # Group shared straight edges by direction; within one direction every face has at most two
-    # such edges, so the face graph is a union of paths and cycles, and the cycles are the loops.
+    # Group shared straight edges by direction; the cycles of each direction's face graph in which
+    # every face has exactly two links are the loops (a four-edge face has at most two edges of
+    # one direction, so under the strict rule every component is a path or a cycle).
     groups: list[tuple[np.ndarray, list[int]]] = []
     for eid, fs in edge_faces.items():
         if len(set(fs)) != 2:
@@ -69,7 +117,7 @@ def find_face_loops(faces: list[TopoDS_Face]) -> dict[int, list[np.ndarray]]:
                 break
         else:
             groups.append((d, [eid]))
-    loops: dict[int, list[np.ndarray]] = defaultdict(list)
+    loops: Loops = defaultdict(list)
     for d, eids in groups:
         pairs = [(min(edge_faces[e]), max(edge_faces[e])) for e in eids]  # two distinct faces each
         for component in _cycles(pairs):
