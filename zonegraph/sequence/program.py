@@ -315,12 +315,12 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
 def _common_operands(a: Shape, b: Shape, fuzzy: float, alike: bool) -> Iterator[tuple[Shape, Shape, float]]:
     """Both orders at ``fuzzy``, then (when that is not 0) both exact, then with a fuzzy value of
     1e-9 of the part (a valid program whose exact commons with the target were all empty took
-    it), then a repaired part and a fresh target, and, for solids of the same volume
-    (``alike``), the part with its tolerances limited (:func:`_tightened`). A fuzzy value helps
-    faces a hair apart and can itself lose the volume (a written file of a corpus part whose
-    commons at every fuzzy value from 1e-9 to 1e-4 of the part held 4% of it, and its exact
-    common all of it). Lazy: the usual first common is whole, and nothing after it is
-    computed."""
+    it), then a repaired part, and, for solids of the same volume (``alike``), the part with its
+    tolerances limited (:func:`_tightened`); each common takes fresh copies
+    (:func:`_common_volume`). A fuzzy value helps faces a hair apart and can itself lose the
+    volume (a written file of a corpus part whose commons at every fuzzy value from 1e-9 to 1e-4
+    of the part held 4% of it, and its exact common all of it). Lazy: the usual first common is
+    whole, and nothing after it is computed."""
     yield a, b, fuzzy
     yield b, a, fuzzy
     if fuzzy > 0.0:
@@ -330,12 +330,15 @@ def _common_operands(a: Shape, b: Shape, fuzzy: float, alike: bool) -> Iterator[
     if tiny > fuzzy:
         yield a, b, tiny
         yield b, a, tiny
-    yield _repaired(a), b, fuzzy
-    yield a, Shape.cast(BRepBuilderAPI_Copy(b.wrapped).Shape()), fuzzy
+    yield _repaired(_copy(a)), b, fuzzy
     tight = _tightened(a) if alike else None
     if tight is not None and tight.is_valid:
         yield tight, b, fuzzy
         yield b, tight, fuzzy
+
+
+def _copy(shape: Shape) -> Shape:
+    return Shape.cast(BRepBuilderAPI_Copy(shape.wrapped).Shape())
 
 
 def _tightened(shape: Shape) -> Shape:
@@ -352,6 +355,10 @@ def _tightened(shape: Shape) -> Shape:
 
 
 def _common_volume(a: Shape, b: Shape, fuzzy: float) -> float:
+    """The volume of one common, taken of copies: a Boolean may enlarge the tolerances of its
+    operands in place, after which later commons with them fail (a target measured against a
+    written JSON whose commons all failed then had empty commons with every other file)."""
+    a, b = _copy(a), _copy(b)
     try:
         if fuzzy <= 0.0:
             return volume_of(a.intersect(b))
