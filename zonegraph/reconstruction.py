@@ -26,7 +26,7 @@ from zonegraph.export.verify import Export, verified_export
 from zonegraph.export.writers import write_outputs
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.deadline import Deadline
-from zonegraph.sequence.program import RebuildError, brep_iou, build_program, execute
+from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou, build_program, execute
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
 from zonegraph.status import Status
@@ -223,12 +223,13 @@ def infer(
     """
     path, out_dir = Path(target_path), Path(out)
     rec = reconstruct(path, config, saved_graph)
-    program = build_program(rec.graph, rec.result.steps, rec.generator)
     target = as_shape(rec.solids)
+    program: list[ProgramStep] = []
     states: list = []
     rebuild_error, iou = "", 0.0
     started = time.perf_counter()
     try:
+        program = build_program(rec.graph, rec.result.steps, rec.generator)
         states = execute(program)
         iou = brep_iou(states[-1] if states else None, target)
     except RebuildError as exc:

@@ -10,16 +10,20 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from build123d import Compound, Face, Pos, Shape, Solid, Vector
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 
 from zonegraph.data.design import Design, ExtentType, Extrude, Operation, Sketch
 from zonegraph.data.profiles import profile_faces
 from zonegraph.errors import DesignError, ReplayError, is_kernel_error
+from zonegraph.geometry.cells import select_cells
+from zonegraph.geometry.occ import fuzzy_boolean, make_compound
 from zonegraph.verified import REPLAY_RTOL, Measured, disagreement, relative_difference
 
 TOUCH_TOL = 1e-6  # cm: a join tool this close to a body merges with it
@@ -34,6 +38,7 @@ class ReplayStep:
     tool: Shape
     bodies: tuple[Solid, ...]
     seconds: float
+    by_cells: bool = False  # the bodies came from the cells of all tools so far (:func:`cells_bodies`)
 
     @property
     def body_count(self) -> int:
@@ -141,16 +146,16 @@ def replay(design: Design) -> ReplayResult:
 
     Raises:
         DesignError, UnsupportedFeatureError: a profile or extent that cannot be built exactly;
-        ReplayError: an OpenCASCADE Boolean failed.
+        ReplayError: an OpenCASCADE Boolean failed, and so did the cells of the tools so far.
     """
     sketches: dict[str, Sketch] = {}
     bodies: tuple[Solid, ...] = ()
-    steps = []
+    steps: list[ReplayStep] = []
     for entity in design.timeline:
         if isinstance(entity, Sketch):
             sketches[entity.id] = entity
             continue
-        step = replay_extrude(bodies, entity, sketches, design.source or design.id)
+        step = replay_extrude(bodies, entity, sketches, design.source or design.id, steps)
         steps.append(step)
         bodies = step.bodies
     if not steps:
@@ -161,21 +166,121 @@ def replay(design: Design) -> ReplayResult:
 
 
 def replay_extrude(
-    bodies: tuple[Solid, ...], extrude: Extrude, sketches: dict[str, Sketch], where: str
+    bodies: tuple[Solid, ...],
+    extrude: Extrude,
+    sketches: dict[str, Sketch],
+    where: str,
+    earlier: Sequence[ReplayStep] | None = None,
 ) -> ReplayStep:
-    """Apply one extrude to ``bodies`` (which are not modified)."""
+    """Apply one extrude to ``bodies`` (which are not modified).
+
+    ``earlier``: the steps that made ``bodies``, when known; a Boolean that fails or gives an
+    invalid solid is then evaluated on the cells of all their tools (:func:`cells_bodies`), and
+    once a step came from the cells, the next ones do too where they can: a Boolean on such
+    bodies can come back valid yet wrong (as in :func:`zonegraph.sequence.program.execute`)."""
     t0 = time.perf_counter()
     try:
         tool = extrude_tool(extrude, sketches, where)
-        after = apply_operation(bodies, tool, extrude.operation)
     except Exception as exc:
         if not is_kernel_error(exc):
             raise  # a ZoneGraphError already names the input; anything else is a bug of ours
         raise _kernel_failure(where, extrude, exc) from None
-    for body in after:
-        if not body.is_valid:
-            raise ReplayError(where, extrude.id, f"{extrude.operation.name.lower()} gave an invalid solid")
-    return ReplayStep(extrude, tool, after, time.perf_counter() - t0)
+    history: list[ReplayStep | tuple[Extrude, Shape]] | None = (
+        None if earlier is None else [*earlier, (extrude, tool)]
+    )
+    if earlier and earlier[-1].by_cells and history is not None:
+        cells = cells_bodies(history)
+        if cells is not None:
+            return ReplayStep(extrude, tool, cells, time.perf_counter() - t0, by_cells=True)
+    failure: ReplayError | None = None
+    try:
+        after = apply_operation(bodies, tool, extrude.operation)
+    except Exception as exc:
+        if not is_kernel_error(exc):
+            raise
+        failure = _kernel_failure(where, extrude, exc)
+    if failure is None and not all(body.is_valid for body in after):
+        failure = ReplayError(where, extrude.id, f"{extrude.operation.name.lower()} gave an invalid solid")
+    if failure is None:
+        return ReplayStep(extrude, tool, after, time.perf_counter() - t0)
+    retried = retried_operation(bodies, tool, extrude.operation)
+    if retried is not None:
+        return ReplayStep(extrude, tool, retried, time.perf_counter() - t0)
+    cells = cells_bodies(history) if history is not None else None
+    if cells is None:
+        raise failure
+    return ReplayStep(extrude, tool, cells, time.perf_counter() - t0, by_cells=True)
+
+
+def retried_operation(bodies: tuple[Solid, ...], tool: Shape, op: Operation) -> tuple[Solid, ...] | None:
+    """A join or cut that gave an invalid solid, again with the bodies as the arguments and the
+    tool as the tool, exact and then at the fuzzy values of ``CELLS_FUZZY_SHARES``; the first
+    valid result, else None. The order matters to OpenCASCADE: a join of a written program
+    whose tool-first fuse was invalid came back valid with the body first."""
+    if op not in (Operation.JOIN, Operation.CUT):
+        return None
+    diag = float(Compound([*bodies, tool]).bounding_box().diagonal)
+    for share in CELLS_FUZZY_SHARES:
+        try:
+            after = _body_first(bodies, tool, op, share * diag)
+        except ValueError:
+            continue
+        if after and all(b.is_valid for b in after):
+            return after
+    return None
+
+
+def _body_first(bodies: tuple[Solid, ...], tool: Shape, op: Operation, fuzzy: float) -> tuple[Solid, ...]:
+    if op is Operation.JOIN:
+        touched = [b for b in bodies if touches(b, tool)]
+        merged = fuzzy_boolean(
+            BRepAlgoAPI_Fuse(), make_compound(t.wrapped for t in touched), tool.wrapped, fuzzy
+        )
+        kept = tuple(b for b in bodies if not any(b is t for t in touched))
+        return kept + tuple(Shape.cast(merged).clean().solids())
+    out: list[Solid] = []
+    for body in bodies:
+        piece = Shape.cast(fuzzy_boolean(BRepAlgoAPI_Cut(), body.wrapped, tool.wrapped, fuzzy))
+        out.extend(s for s in piece.clean().solids() if s.volume > 0)
+    return tuple(out)
+
+
+# Fuzzy values of the retried Booleans and the cells fallback, as shares of the shapes'
+# bounding-box diagonal: exact first (the rebuild's own values, program.FUZZY_SHARES).
+CELLS_FUZZY_SHARES = (0.0, 1e-7, 1e-5)
+POINT_SET_OPERATIONS = (Operation.NEW_BODY, Operation.JOIN, Operation.CUT)
+
+
+def cells_bodies(steps: Sequence[ReplayStep | tuple[Extrude, Shape]]) -> tuple[Solid, ...] | None:
+    """The bodies after ``steps`` from one general fuse of all their tools, each cell kept when
+    the last step whose tool holds it adds material; None when that does not apply or fails.
+
+    A chain of Booleans fails where one link does (a join of a tool sharing a cylindrical wall
+    with the body comes back invalid, in the replay of a program ``zonegraph infer`` wrote,
+    whose own rebuild took its cells); the cells of one fuse do not depend on the chain. They
+    give the point set of new-body, join and cut steps, whatever the bodies (an intersect acts
+    per body, so it is not evaluated), as one solid per connected piece: bodies that overlap
+    without a join merge, which only the fallback's callers, where the Booleans failed, see."""
+    pairs = [(s.extrude, s.tool) if isinstance(s, ReplayStep) else s for s in steps]
+    if any(x.operation not in POINT_SET_OPERATIONS for x, _ in pairs):
+        return None
+    adds = [x.operation is not Operation.CUT for x, _ in pairs]
+    tools = [t.wrapped for _, t in pairs]
+    diag = float(Compound([t for _, t in pairs]).bounding_box().diagonal)
+    for share in CELLS_FUZZY_SHARES:
+        try:
+            shape = Shape.cast(select_cells(tools, partial(_last_adds, adds), share * diag))
+        except RuntimeError:
+            continue
+        solids = tuple(s for s in shape.solids() if s.volume > 0)
+        if solids and all(s.is_valid for s in solids):
+            return solids
+    return None
+
+
+def _last_adds(adds: list[bool], owners: frozenset[int]) -> bool:
+    """Whether a cell inside the tools ``owners`` is material: the last of them adds."""
+    return adds[max(owners)] if owners else False
 
 
 def _kernel_failure(where: str, extrude: Extrude, exc: Exception) -> ReplayError:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from build123d import Edge, Face, GeomType, Shape, Unit, Vector
+from build123d import Face, GeomType, Shape, Unit, Vector
 
 from zonegraph.data.design import (
     Arc,
@@ -36,6 +36,7 @@ from zonegraph.data.design import (
     Sketch,
     design_to_json,
 )
+from zonegraph.export.loops import LoopEdge, loop_edges
 from zonegraph.export.render import render_sequence
 from zonegraph.export.snap import Snapper, written
 from zonegraph.geometry.shapes import write_step
@@ -82,11 +83,54 @@ class LocalEdge:
     radius: float = 0.0
 
 
-def _arc(edge: Edge, frame: Frame, snap: Snapper) -> LocalEdge:
+def _arc_through(
+    start: np.ndarray, end: np.ndarray, centre: np.ndarray, mid: np.ndarray, radius: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Centre and mid point of the arc of ``radius`` from ``start`` to ``end`` (the loop's corners,
+    which lie up to the vertex tolerance off the edge's circle) on the side of the edge's own
+    ``centre``, its mid point nearest the edge's own ``mid``. The original mid point with moved
+    ends can be collinear with them (a 0.008 cm arc of radius 2.6 whose corner sat 1.3e-5 off it:
+    "GC_MakeArcOfCircle::Value() - no result"); this arc keeps the designer's radius and bulge."""
+    half = (end - start) / 2
+    chord = float(np.linalg.norm(half[:2]))
+    if chord == 0.0:
+        return centre, mid
+    normal = np.array([-half[1], half[0], 0.0]) / chord
+    side = 1.0 if float((centre - (start + half)) @ normal) >= 0 else -1.0
+    new_centre = start + half + side * math.sqrt(max(radius**2 - chord**2, 0.0)) * normal
+    out = mid - new_centre
+    return new_centre, new_centre + radius * out / np.linalg.norm(out)
+
+
+def _bulge(start: np.ndarray, mid: np.ndarray, end: np.ndarray) -> float:
+    """How far ``mid`` lies off the chord from ``start`` to ``end`` (in the sketch plane)."""
+    chord = (end - start)[:2]
+    length = float(np.linalg.norm(chord))
+    off = (mid - start)[:2]
+    return (
+        float(np.linalg.norm(off))
+        if length == 0.0
+        else abs(float(chord[0] * off[1] - chord[1] * off[0])) / length
+    )
+
+
+def _line(start: np.ndarray, end: np.ndarray, snap: Snapper) -> LocalEdge:
+    ends = [snap.point(start), snap.point(end)]
+    return LocalEdge("line", np.array(ends), Line(vec3(ends[0]), vec3(ends[1])))
+
+
+def _arc(piece: LoopEdge, frame: Frame, snap: Snapper) -> LocalEdge:
     """Start, mid and end point (the script's ThreePointArc); centre and radius (the JSON's arc),
     each snapped like any other number; the JSON's reference direction is a snapped unit vector."""
-    points = [snap.point(_local(frame, edge.position_at(t))) for t in (0, 0.5, 1)]
-    centre = snap.point(_local(frame, edge.arc_center))
+    edge = piece.edge
+    start, end = (_local(frame, q) for q in (piece.start, piece.end))
+    raw_centre, raw_mid = _arc_through(
+        start, end, _local(frame, edge.arc_center), _local(frame, edge.position_at(0.5)), edge.radius
+    )
+    if _bulge(start, raw_mid, end) <= snap.tol:
+        return _line(start, end, snap)  # straight within what a number may move; snapped, no arc
+    points = [snap.point(start), snap.point(raw_mid), snap.point(end)]
+    centre = snap.point(raw_centre)
     radius = snap.length(edge.radius)
     a, m, b = (q - centre for q in points)
     sign = 1.0 if a[0] * m[1] - a[1] * m[0] > 0 else -1.0
@@ -97,12 +141,14 @@ def _arc(edge: Edge, frame: Frame, snap: Snapper) -> LocalEdge:
     return LocalEdge("arc", np.array(points), arc, radius)
 
 
-def _nurbs(edge: Edge, frame: Frame) -> Nurbs:
-    """The JSON's B-spline of a free-form edge, in the (snapped) sketch frame. Its poles are not
-    snapped: nobody edits them, and moving the curve off the original would buy nothing."""
-    spline = edge.to_splines(degree=SPLINE_DEGREE, tolerance=SPLINE_TOL)
+def _nurbs(piece: LoopEdge, frame: Frame, first: np.ndarray, last: np.ndarray) -> Nurbs:
+    """The JSON's B-spline of a free-form edge, in the (snapped) sketch frame, its end poles on the
+    loop's (snapped) corners ``first`` and ``last``. The other poles are not snapped: nobody edits
+    them, and moving the curve off the original would buy nothing."""
+    spline = piece.edge.to_splines(degree=SPLINE_DEGREE, tolerance=SPLINE_TOL)
     geom = spline.geom_adaptor().BSpline()
     poles = [_local(frame, (q.X(), q.Y(), q.Z())) for q in geom.Poles()]
+    poles[0], poles[-1] = first, last  # clamped: the end poles are the end points
     knots = [k for k, m in zip(geom.Knots(), geom.Multiplicities(), strict=False) for _ in range(m)]
     weights = list(geom.Weights()) if geom.IsRational() else None
     return Nurbs(
@@ -110,27 +156,30 @@ def _nurbs(edge: Edge, frame: Frame) -> Nurbs:
     )
 
 
-def local_edge(edge: Edge, frame: Frame, snap: Snapper | None = None) -> LocalEdge:
-    """An edge of a sketch face in the sketch's frame, its numbers snapped."""
+def local_edge(piece: LoopEdge, frame: Frame, snap: Snapper | None = None) -> LocalEdge:
+    """An edge of a sketch loop in the sketch's frame between the loop's corners, its numbers
+    snapped (a corner snaps to the same point for both edges that meet there)."""
     snap = snap or Snapper.raw()
+    edge = piece.edge
     kind = edge.geom_type
-    if kind == GeomType.LINE:
-        ends = [snap.point(_local(frame, edge.position_at(t))) for t in (0, 1)]
-        return LocalEdge("line", np.array(ends), Line(vec3(ends[0]), vec3(ends[1])))
     if kind == GeomType.CIRCLE and edge.is_closed:
         centre = snap.point(_local(frame, edge.arc_center))
         radius = snap.length(edge.radius)
         return LocalEdge("circle", np.array([centre]), Circle(vec3(centre), radius, (0.0, 0.0, 1.0)), radius)
+    if kind == GeomType.LINE:
+        return _line(_local(frame, piece.start), _local(frame, piece.end), snap)
     if kind == GeomType.CIRCLE:
-        return _arc(edge, frame, snap)
-    samples = [snap.point(_local(frame, edge.position_at(t))) for t in np.linspace(0, 1, SPLINE_SAMPLES)]
-    return LocalEdge("spline", np.array(samples), _nurbs(edge, frame))
+        return _arc(piece, frame, snap)
+    first, last = (snap.point(_local(frame, q)) for q in (piece.first, piece.last))
+    inside = [snap.point(_local(frame, edge.position_at(t))) for t in np.linspace(0, 1, SPLINE_SAMPLES)[1:-1]]
+    return LocalEdge("spline", np.array([first, *inside, last]), _nurbs(piece, frame, first, last))
 
 
-def face_wires(face: Face) -> list[tuple[bool, list[Edge]]]:
-    """(is_outer, edges) per boundary loop; merged faces can carry empty wires, which are dropped."""
+def face_wires(face: Face) -> list[tuple[bool, list[LoopEdge]]]:
+    """(is_outer, edges in loop order) per boundary loop; merged faces can carry empty wires,
+    which are dropped."""
     wires = [(True, face.outer_wire())] + [(False, w) for w in face.inner_wires()]
-    return [(outer, list(w.edges())) for outer, w in wires if w.edges()]
+    return [(outer, loop_edges(w, face)) for outer, w in wires if w.edges()]
 
 
 @dataclass(frozen=True)

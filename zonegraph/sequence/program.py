@@ -9,6 +9,7 @@ and compared with the target by OpenCASCADE Booleans: that B-rep IoU is the hone
 from __future__ import annotations
 
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import partial
 
@@ -20,6 +21,7 @@ from OCP.Precision import Precision
 from OCP.ShapeFix import ShapeFix_Shape, ShapeFix_ShapeTolerance
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SHAPE, TopAbs_SOLID
 
+from zonegraph.errors import is_kernel_error
 from zonegraph.geometry.cells import select_cells
 from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, precise_volume
 from zonegraph.geometry.shapes import volume_of
@@ -44,12 +46,36 @@ class ProgramStep:
         A face is first turned to face the extrusion direction: a prism swept against its
         face's normal is an inside-out solid that the checker rejects and Booleans mishandle."""
         d = Vector(*self.direction) * self.distance
-        solids = [Solid.extrude(_facing(f, d), d) for f in self.faces]
+        solids = [_prism(f, d) for f in self.faces]
         return solids[0] if len(solids) == 1 else solids[0].fuse(*solids[1:]).clean()
 
 
 def _facing(face: Face, d: Vector) -> Face:
     return face if face.normal_at().dot(d) >= 0 else Face(face.wrapped.Reversed())
+
+
+def _prism(face: Face, d: Vector) -> Solid:
+    """``face`` swept along ``d``; where OpenCASCADE's prism refuses the face as it is (a sketch
+    face of the fuzzy partition whose wire it finds open: "Courbes non jointives"), the face
+    repaired by ShapeFix, which joins such wires.
+
+    Raises:
+        RebuildError: neither face could be swept (``result.json`` says why).
+    """
+    try:
+        return Solid.extrude(_facing(face, d), d)
+    except Exception as exc:
+        if not is_kernel_error(exc):
+            raise
+        first = exc
+    fixed = _repaired(face).faces()
+    try:
+        if len(fixed) == 1:
+            return Solid.extrude(_facing(fixed[0], d), d)
+    except Exception as exc:
+        if not is_kernel_error(exc):
+            raise
+    raise RebuildError(f"a sketch face could not be extruded: {type(first).__name__}: {first}")
 
 
 def partition_faces(graph: ZoneGraph) -> list:
@@ -77,14 +103,15 @@ def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGe
 
     Raises:
         ValueError: the graph was loaded without its zone solids.
+        RebuildError: OpenCASCADE failed to merge a step's faces.
     """
     faces = partition_faces(graph)
     norm = graph.normalization
     out = []
-    for p in steps:
-        sketch = [
-            Shape.cast(norm.apply(f.wrapped, inverse=True)) for f in merge_faces([faces[i] for i in p.faces])
-        ]
+    for k, p in enumerate(steps, 1):
+        with kernel_guard(f"step {k}: its sketch faces did not merge"):
+            merged = merge_faces([faces[i] for i in p.faces])
+        sketch = [Shape.cast(norm.apply(f.wrapped, inverse=True)) for f in merged]
         d = generator.direction(p.start, p.end) / norm.scale
         length = float(np.linalg.norm(d))
         origin = norm.to_original(graph.surface_normal[p.start] * graph.surface_offset[p.start])
@@ -101,8 +128,21 @@ def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGe
 
 
 class RebuildError(RuntimeError):
-    """An OpenCASCADE Boolean failed on the program's own tools (a robustness failure, not a
-    wrong program): the shapes share coincident curved faces it cannot resolve."""
+    """OpenCASCADE failed on the program's own sketches or tools (a robustness failure, not a
+    wrong program): e.g. shapes sharing coincident curved faces it cannot resolve."""
+
+
+@contextmanager
+def kernel_guard(what: str) -> Iterator[None]:
+    """Turns OpenCASCADE's exceptions within into a :class:`RebuildError` naming ``what`` failed,
+    so ``infer`` reports a ``rebuild_failed`` part with the reason instead of failing; anything
+    else is a bug of ours and keeps its traceback."""
+    try:
+        yield
+    except Exception as exc:
+        if not is_kernel_error(exc):
+            raise
+        raise RebuildError(f"{what}: {type(exc).__name__}: {exc}") from None
 
 
 def execute(program: list[ProgramStep]) -> list[Shape | None]:
@@ -121,11 +161,13 @@ def execute(program: list[ProgramStep]) -> list[Shape | None]:
     tools: list[Shape] = []
     by_cells = False
     for i, step in enumerate(program):
-        tools.append(step.tool())
+        with kernel_guard(f"step {i + 1}: its tool failed"):
+            tools.append(step.tool())
         if shape is None:
             shape = tools[-1] if step.op is Op.UNION else None
         else:
-            shape, by_cells = _step(shape, tools, [s.op for s in program[: i + 1]], by_cells)
+            with kernel_guard(f"step {i + 1}: its Boolean failed"):
+                shape, by_cells = _step(shape, tools, [s.op for s in program[: i + 1]], by_cells)
         states.append(shape)
     return states
 
@@ -271,22 +313,32 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
 
 
 def _common_operands(a: Shape, b: Shape, fuzzy: float, alike: bool) -> Iterator[tuple[Shape, Shape, float]]:
-    """Both orders, exact then with a fuzzy value of 1e-9 of the part (a valid program whose exact
-    commons with the target were all empty took it), then a repaired part and a fresh target,
-    and, for solids of the same volume (``alike``), the part with its tolerances limited
-    (:func:`_tightened`). Lazy: the usual first common is whole, and nothing after it is
-    computed."""
+    """Both orders at ``fuzzy``, then (when that is not 0) both exact, then with a fuzzy value of
+    1e-9 of the part (a valid program whose exact commons with the target were all empty took
+    it), then a repaired part, and, for solids of the same volume (``alike``), the part with its
+    tolerances limited (:func:`_tightened`); each common takes fresh copies
+    (:func:`_common_volume`). A fuzzy value helps faces a hair apart and can itself lose the
+    volume (a written file of a corpus part whose commons at every fuzzy value from 1e-9 to 1e-4
+    of the part held 4% of it, and its exact common all of it). Lazy: the usual first common is
+    whole, and nothing after it is computed."""
     yield a, b, fuzzy
     yield b, a, fuzzy
-    tiny = max(fuzzy, 1e-9 * float(b.bounding_box().diagonal))
-    yield a, b, tiny
-    yield b, a, tiny
-    yield _repaired(a), b, fuzzy
-    yield a, Shape.cast(BRepBuilderAPI_Copy(b.wrapped).Shape()), fuzzy
+    if fuzzy > 0.0:
+        yield a, b, 0.0
+        yield b, a, 0.0
+    tiny = 1e-9 * float(b.bounding_box().diagonal)
+    if tiny > fuzzy:
+        yield a, b, tiny
+        yield b, a, tiny
+    yield _repaired(_copy(a)), b, fuzzy
     tight = _tightened(a) if alike else None
     if tight is not None and tight.is_valid:
         yield tight, b, fuzzy
         yield b, tight, fuzzy
+
+
+def _copy(shape: Shape) -> Shape:
+    return Shape.cast(BRepBuilderAPI_Copy(shape.wrapped).Shape())
 
 
 def _tightened(shape: Shape) -> Shape:
@@ -303,10 +355,13 @@ def _tightened(shape: Shape) -> Shape:
 
 
 def _common_volume(a: Shape, b: Shape, fuzzy: float) -> float:
+    """The volume of one common, taken of copies: a Boolean may enlarge the tolerances of its
+    operands in place, after which later commons with them fail (a target measured against a
+    written JSON whose commons all failed then had empty commons with every other file)."""
+    a, b = _copy(a), _copy(b)
     try:
         if fuzzy <= 0.0:
             return volume_of(a.intersect(b))
         return precise_volume(fuzzy_boolean(BRepAlgoAPI_Common(), a.wrapped, b.wrapped, fuzzy))
     except ValueError:  # a null or failed Boolean result
         return 0.0
-
