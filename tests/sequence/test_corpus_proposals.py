@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.testing import requires_corpus
-from zonegraph.testing.corpus import corpus_replay, corpus_shape
+from zonegraph.testing.corpus import corpus_shape
 from zonegraph.zones.build import build_zone_graph
 
 pytestmark = requires_corpus
@@ -22,16 +21,3 @@ def test_a_prism_across_a_crossing_cylinder_is_proposed():
     assert proposals
     crossing = [p for p in proposals if p.zones.sum() > 1 and (p.zones & graph.zone_inside).any()]
     assert crossing  # a union that takes zones on both sides of a curved wall
-
-
-def test_a_first_step_that_is_part_of_a_component_is_proposed():
-    """A plate whose rounded corners are cut away: on its base plane the plate's footprint shares
-    edges with the corners' faces, so the whole component (corners included) was the only union
-    sketch there and the designer's first extrude was never proposed."""
-    r = corpus_replay("04_6to7ops/batch_007.py", "41599_f66b4e5b_0010")
-    graph = build_zone_graph(list(r.bodies), samples=0)
-    operations = [s["operation"] for s in r.summary()["steps"]]
-    gt = ground_truth(graph, [s.tool.wrapped for s in r.steps], operations)
-    first = gt.steps[0]
-    assert first.mapped and first.operation == "new_body"
-    assert first.captured[1]

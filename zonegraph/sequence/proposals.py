@@ -8,14 +8,12 @@ partition faces on s are grouped by the zone just beyond them along d:
 3. in the target, or in neither: can start a union.
 
 A sketch is a connected component of a group (faces sharing an edge on s), the union of the
-group's components, or (proposal level k) any 1..k or N-k..N of them; and, as one more sketch, the
-group's faces whose prisms meet the target (a footprint that is part of a component).
-Each sketch face is swept along d to e through the zones it meets: from the face into the zone
-beyond it, then across that zone's caps (planar faces facing along d, and curved faces not on a
-cylinder or extrusion along d), never its side walls (cylinders and extrusions along d), until
-plane e. The zones swept must fill the prism exactly (volume = face area x |d|, relative 1e-4); a
-face that fails rejects the whole sketch. Sweeps are memoised per (face, s, e): the geometry never
-changes during search.
+group's components, or (proposal level k) any 1..k or N-k..N of them. Each sketch face is swept
+along d to e through the zones it meets: from the face into the zone beyond it, then across that
+zone's caps (planar faces facing along d, and curved faces not on a cylinder or extrusion along d),
+never its side walls (cylinders and extrusions along d), until plane e. The zones swept must fill
+the prism exactly (volume = face area x |d|, relative 1e-4); a face that fails rejects the whole
+sketch. Sweeps are memoised per (face, s, e): the geometry never changes during search.
 """
 
 from __future__ import annotations
@@ -126,7 +124,6 @@ class ProposalGenerator:
         self._side_lists: dict[int, list[int]] = {}
         self._crossed: dict[tuple[int, int], tuple[list[bool], list[bool]]] = {}
         self._groups: dict[tuple[int, int, bytes], _Candidates] = {}
-        self._meets: dict[tuple[int, int], np.ndarray] = {}
         self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
         self._flatten_pairs()
 
@@ -301,39 +298,6 @@ class ProposalGenerator:
             comps.setdefault(root(f), []).append(f)
         return sorted(sorted(c) for c in comps.values())
 
-    def _group_sketches(self, s: int, e: int, mask: np.ndarray) -> list[tuple[int, ...]]:
-        """The sketches of a group, and the group less its faces whose prisms miss the target.
-
-        A designer's first sketch is often only part of an edge-connected component of its
-        group: a plate whose corners are cut away later shares edges with the corners' faces on
-        its base plane, so the only union sketches there took the corners too. The faces whose
-        prisms meet the target, as one sketch, give that footprint back; a face whose prism the
-        zones do not fill (a sliver) is left out of it, so it no longer rejects the rest. Only the
-        whole part is added, not its components: those multiplied the proposals per state. And
-        only to a group of every face with a zone beyond (group 3 on the empty canvas, or on one
-        inside the target): the part is then the same on every such canvas, swept once per plane
-        pair, where on every other group it cost a new sweep per state (proposals per state 2x,
-        generation time 8x on the bench's draw) for a step or two more."""
-        out = dict.fromkeys(self.sketches(self.faces_on[s][mask], s))
-        if not np.array_equal(mask, self._beyond[(s, e)] >= 0):
-            return list(out)
-        part = mask & self._meets_target(s, e)
-        if part.any() and not np.array_equal(part, mask):
-            out[tuple(self.faces_on[s][part].tolist())] = None
-        return list(out)
-
-    def _meets_target(self, s: int, e: int) -> np.ndarray:
-        """For each face on s, whether the zones fill its prism to e and some are in the target
-        (memoised per plane pair: the geometry never changes during search)."""
-        hit = self._meets.get((s, e))
-        if hit is None:
-            hit = np.zeros(len(self.faces_on[s]), bool)
-            for i, f in enumerate(self.faces_on[s].tolist()):
-                swept = self.sweep(f, s, e)
-                hit[i] = swept is not None and bool(self.target[swept].any())
-            self._meets[(s, e)] = hit
-        return hit
-
     def extrusion(self, faces: tuple[int, ...], s: int, e: int) -> np.ndarray | None:
         volume = np.zeros(self.graph.n_zones, bool)
         for f in faces:
@@ -356,7 +320,7 @@ class ProposalGenerator:
         hit = self._groups.get(key)
         if hit is None:
             volumes, union, subtract = [], [], []
-            for sketch in self._group_sketches(s, e, mask):
+            for sketch in self.sketches(self.faces_on[s][mask], s):
                 if deadline is not None and deadline.passed():
                     return None
                 volume = self.extrusion(sketch, s, e)

@@ -11,20 +11,15 @@ from build123d import Shape
 
 from zonegraph.data.b123d import convert_design
 from zonegraph.data.design import parse_design
-from zonegraph.data.replay import ReplayResult, replay
+from zonegraph.data.replay import replay
 from zonegraph.testing.locations import CORPUS
 
-__all__ = ["corpus_replay", "corpus_shape"]
+__all__ = ["corpus_shape"]
 
 
 @functools.cache
-def corpus_replay(batch: str, design_id: str) -> ReplayResult:
-    """The replay of one corpus design (``batch`` relative to the corpus root): its tools too."""
-    converted = convert_design(CORPUS / batch, design_id)
-    assert converted.ok and converted.design_json is not None, converted.reason
-    return replay(parse_design(converted.design_json, design_id))
-
-
 def corpus_shape(batch: str, design_id: str) -> Shape:
     """The final shape of one corpus design (``batch`` relative to the corpus root)."""
-    return corpus_replay(batch, design_id).shape
+    converted = convert_design(CORPUS / batch, design_id)
+    assert converted.ok and converted.design_json is not None, converted.reason
+    return replay(parse_design(converted.design_json, design_id)).shape
