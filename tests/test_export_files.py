@@ -3,6 +3,10 @@
 41737_b6724677_0000's sketch faces come from the fuzzy partition with curves that end 1.3e-5 cm
 apart at a vertex: written edge by edge from the curves, neither the script (make_face: "Face can
 only be created with closed wires") nor the JSON ("a profile loop does not close") rebuilt.
+24650_dad8c8ee_0000's loop has a free-form edge whose samples run against the loop: written from
+the wrong corner, the script's spline crossed itself ("TopoDS::Face" type mismatch).
+69456_81a21eaf_0000's corners lie 1.1e-6 cm off the sketch plane (their vertices' tolerance):
+written there, the JSON's hole was not coplanar and the reader built the profile without it.
 """
 
 from __future__ import annotations
@@ -10,6 +14,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from build123d import Box, Pos
 
 from zonegraph.configs import InferConfig
@@ -18,14 +23,20 @@ from zonegraph.data.replay import cells_bodies
 from zonegraph.reconstruction import EXACT_IOU, infer
 from zonegraph.testing import CORPUS, requires_corpus
 
-OPEN_LOOP_DESIGN = ("01_2ops/batch_012.py", "41737_b6724677_0000")
+WRITTEN_LOOP_DESIGNS = [
+    ("01_2ops/batch_012.py", "41737_b6724677_0000"),
+    ("02_3ops/batch_003.py", "24650_dad8c8ee_0000"),
+    ("06_11to15ops/batch_005.py", "69456_81a21eaf_0000"),
+]
 
 
 @requires_corpus
-def test_a_partition_face_with_gaps_at_its_vertices_is_written_as_closed_loops(tmp_path: Path) -> None:
+@pytest.mark.parametrize(("batch", "design_id"), WRITTEN_LOOP_DESIGNS)
+def test_partition_faces_are_written_as_closed_planar_loops(
+    batch: str, design_id: str, tmp_path: Path
+) -> None:
     from zonegraph.data.b123d import convert_design
 
-    batch, design_id = OPEN_LOOP_DESIGN
     converted = convert_design(CORPUS / batch, design_id)
     assert converted.ok and converted.design_json is not None, converted.reason
     path = tmp_path / f"{design_id}.json"

@@ -30,23 +30,13 @@ MIN_EDGE = SNAP_TOL
 
 @dataclass(frozen=True)
 class LoopEdge:
-    """An edge of a loop with the corners it is written between (world coordinates).
-
-    ``first`` and ``last`` are the corners at the start and the end of the edge's own curve
-    parameter; ``start`` and ``end`` the same two in the loop's running order."""
+    """An edge of a loop with the corners it is written between (world coordinates), in the
+    loop's running order; ``reversed``: the edge runs against its curve in the loop."""
 
     edge: Edge
     reversed: bool
     start: np.ndarray
     end: np.ndarray
-
-    @property
-    def first(self) -> np.ndarray:
-        return self.end if self.reversed else self.start
-
-    @property
-    def last(self) -> np.ndarray:
-        return self.start if self.reversed else self.end
 
 
 def _point(vertex: object) -> np.ndarray:

@@ -68,7 +68,12 @@ def step_frame(step: ProgramStep, snap: Snapper | None = None) -> Frame:
 
 
 def _local(frame: Frame, p: Sequence[float] | np.ndarray | Vector) -> np.ndarray:
-    return frame.matrix.T @ (np.asarray(tuple(p), float) - np.asarray(frame.origin, float))
+    """A point of the sketch in its frame, on the plane: a loop corner is its vertex, which can lie
+    up to the vertex tolerance off the plane (1.1e-6 cm on the corpus), and a profile whose curves
+    are not coplanar loses its holes in the JSON reader (a hole-less area, refused)."""
+    local = frame.matrix.T @ (np.asarray(tuple(p), float) - np.asarray(frame.origin, float))
+    local[2] = 0.0
+    return local
 
 
 @dataclass(frozen=True)
@@ -141,14 +146,16 @@ def _arc(piece: LoopEdge, frame: Frame, snap: Snapper) -> LocalEdge:
     return LocalEdge("arc", np.array(points), arc, radius)
 
 
-def _nurbs(piece: LoopEdge, frame: Frame, first: np.ndarray, last: np.ndarray) -> Nurbs:
+def _nurbs(piece: LoopEdge, frame: Frame, snap: Snapper) -> Nurbs:
     """The JSON's B-spline of a free-form edge, in the (snapped) sketch frame, its end poles on the
-    loop's (snapped) corners ``first`` and ``last``. The other poles are not snapped: nobody edits
-    them, and moving the curve off the original would buy nothing."""
+    loop's (snapped) corners. The other poles are not snapped: nobody edits them, and moving the
+    curve off the original would buy nothing."""
     spline = piece.edge.to_splines(degree=SPLINE_DEGREE, tolerance=SPLINE_TOL)
     geom = spline.geom_adaptor().BSpline()
-    poles = [_local(frame, (q.X(), q.Y(), q.Z())) for q in geom.Poles()]
-    poles[0], poles[-1] = first, last  # clamped: the end poles are the end points
+    world = [np.array((q.X(), q.Y(), q.Z())) for q in geom.Poles()]
+    poles = [_local(frame, q) for q in world]
+    ends = _from_nearest(world[0], piece.start, piece.end)
+    poles[0], poles[-1] = (snap.point(_local(frame, q)) for q in ends)  # clamped: end poles are the ends
     knots = [k for k, m in zip(geom.Knots(), geom.Multiplicities(), strict=False) for _ in range(m)]
     weights = list(geom.Weights()) if geom.IsRational() else None
     return Nurbs(
@@ -170,9 +177,19 @@ def local_edge(piece: LoopEdge, frame: Frame, snap: Snapper | None = None) -> Lo
         return _line(_local(frame, piece.start), _local(frame, piece.end), snap)
     if kind == GeomType.CIRCLE:
         return _arc(piece, frame, snap)
-    first, last = (snap.point(_local(frame, q)) for q in (piece.first, piece.last))
+    begin = np.array(tuple(edge.position_at(0)))
+    first, last = (snap.point(_local(frame, q)) for q in _from_nearest(begin, piece.start, piece.end))
     inside = [snap.point(_local(frame, edge.position_at(t))) for t in np.linspace(0, 1, SPLINE_SAMPLES)[1:-1]]
-    return LocalEdge("spline", np.array([first, *inside, last]), _nurbs(piece, frame, first, last))
+    return LocalEdge("spline", np.array([first, *inside, last]), _nurbs(piece, frame, snap))
+
+
+def _from_nearest(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The two corners of an edge, the one nearest ``p`` (where its samples or poles begin) first.
+
+    Decided by geometry, not by the edge's orientation flag: build123d's ``position_at`` and the
+    B-spline's poles each run in their own direction, and a spline written from the wrong corner
+    crosses itself ("TopoDS::Face" type mismatch in the script, a wrong profile area in the JSON)."""
+    return (a, b) if float(np.linalg.norm(p - a)) <= float(np.linalg.norm(p - b)) else (b, a)
 
 
 def face_wires(face: Face) -> list[tuple[bool, list[LoopEdge]]]:
