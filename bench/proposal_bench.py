@@ -30,7 +30,7 @@ import pandas as pd
 
 from bench.corpus import write_results
 from zonegraph.isolation import run_isolated
-from zonegraph.sequence.ground_truth import MAPPING_RTOL, map_tool, search_op
+from zonegraph.sequence.ground_truth import MAPPING_RTOL, apply_operation, map_tool, search_op
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.status import Status
 from zonegraph.zones.model import ZoneGraph
@@ -80,14 +80,6 @@ def prepared(design_id: str, designs: Path, cache: Path, timeout: float) -> Prep
     return value if isinstance(value, str) else Prepared(**value)
 
 
-def _apply(operation: str, canvas: np.ndarray, zones: np.ndarray) -> np.ndarray:
-    if operation == "cut":
-        return canvas & ~zones
-    if operation == "intersect":
-        return canvas & zones
-    return canvas | zones
-
-
 def measure(p: Prepared, level: int) -> dict:
     """Walk the GT path with a fresh generator: capture, proposal counts and times per state."""
     t0 = time.perf_counter()
@@ -96,7 +88,7 @@ def measure(p: Prepared, level: int) -> dict:
     canvas = np.zeros(p.graph.n_zones, bool)
     steps = []
     for i, (zones, operation, mapped) in enumerate(zip(p.zones, p.operations, p.mapped, strict=True)):
-        after = _apply(operation, canvas, zones)
+        after = apply_operation(operation, canvas, zones)
         t1 = time.perf_counter()
         props = gen.proposals(canvas)
         seconds = time.perf_counter() - t1

@@ -22,7 +22,7 @@ from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from zonegraph.data.design import Design, ExtentType, Extrude, Operation, Sketch
 from zonegraph.data.profiles import profile_faces
 from zonegraph.errors import DesignError, ReplayError, is_kernel_error
-from zonegraph.geometry.cells import select_cells
+from zonegraph.geometry.cells import FUZZY_SHARES, cells_by_fuzzy
 from zonegraph.geometry.occ import fuzzy_boolean, make_compound
 from zonegraph.verified import REPLAY_RTOL, Measured, disagreement, relative_difference
 
@@ -214,13 +214,13 @@ def replay_extrude(
 
 def retried_operation(bodies: tuple[Solid, ...], tool: Shape, op: Operation) -> tuple[Solid, ...] | None:
     """A join or cut that gave an invalid solid, again with the bodies as the arguments and the
-    tool as the tool, exact and then at the fuzzy values of ``CELLS_FUZZY_SHARES``; the first
+    tool as the tool, exact and then at the fuzzy values of ``FUZZY_SHARES``; the first
     valid result, else None. The order matters to OpenCASCADE: a join of a written program
     whose tool-first fuse was invalid came back valid with the body first."""
     if op not in (Operation.JOIN, Operation.CUT):
         return None
     diag = float(Compound([*bodies, tool]).bounding_box().diagonal)
-    for share in CELLS_FUZZY_SHARES:
+    for share in FUZZY_SHARES:
         try:
             after = _body_first(bodies, tool, op, share * diag)
         except ValueError:
@@ -245,9 +245,6 @@ def _body_first(bodies: tuple[Solid, ...], tool: Shape, op: Operation, fuzzy: fl
     return tuple(out)
 
 
-# Fuzzy values of the retried Booleans and the cells fallback, as shares of the shapes'
-# bounding-box diagonal: exact first (the rebuild's own values, program.FUZZY_SHARES).
-CELLS_FUZZY_SHARES = (0.0, 1e-7, 1e-5)
 POINT_SET_OPERATIONS = (Operation.NEW_BODY, Operation.JOIN, Operation.CUT)
 
 
@@ -267,12 +264,8 @@ def cells_bodies(steps: Sequence[ReplayStep | tuple[Extrude, Shape]]) -> tuple[S
     adds = [x.operation is not Operation.CUT for x, _ in pairs]
     tools = [t.wrapped for _, t in pairs]
     diag = float(Compound([t for _, t in pairs]).bounding_box().diagonal)
-    for share in CELLS_FUZZY_SHARES:
-        try:
-            shape = Shape.cast(select_cells(tools, partial(_last_adds, adds), share * diag))
-        except RuntimeError:
-            continue
-        solids = tuple(s for s in shape.solids() if s.volume > 0)
+    for cells in cells_by_fuzzy(tools, partial(_last_adds, adds), diag):
+        solids = tuple(s for s in Shape.cast(cells).solids() if s.volume > 0)
         if solids and all(s.is_valid for s in solids):
             return solids
     return None

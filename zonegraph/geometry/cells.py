@@ -7,7 +7,7 @@ face, so the result has the target's faces, not the zones'.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 
 from OCP.BOPAlgo import BOPAlgo_CellsBuilder
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
@@ -26,6 +26,23 @@ def fuse_zones(zones: Sequence[TopoDS_Shape], selected: Sequence[int]) -> TopoDS
         builder.AddToResult(shape_list([zones[i]]), shape_list([]), 1, False)
     builder.RemoveInternalBoundaries()
     return _unified(builder.Shape())
+
+
+# Fuzzy values of a Boolean or a cells evaluation, as shares of the operands' bounding-box
+# diagonal, tried in turn: exact first, then values that close the tolerance gaps of corpus parts.
+FUZZY_SHARES = (0.0, 1e-7, 1e-5)
+
+
+def cells_by_fuzzy(
+    arguments: Sequence[TopoDS_Shape], keep: Callable[[frozenset[int]], bool], diag: float
+) -> Iterator[TopoDS_Shape]:
+    """:func:`select_cells` at each of ``FUZZY_SHARES`` of ``diag`` in turn (a fuse that raises is
+    skipped), for the caller to take the first result it accepts."""
+    for share in FUZZY_SHARES:
+        try:
+            yield select_cells(arguments, keep, share * diag)
+        except RuntimeError:
+            continue
 
 
 def select_cells(

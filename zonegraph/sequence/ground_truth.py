@@ -102,7 +102,8 @@ def map_tool(graph: ZoneGraph, tool: TopoDS_Shape) -> tuple[np.ndarray, float]:
     return zones, error
 
 
-def _apply(operation: str, canvas: np.ndarray, zones: np.ndarray) -> np.ndarray:
+def apply_operation(operation: str, canvas: np.ndarray, zones: np.ndarray) -> np.ndarray:
+    """The canvas after a Fusion operation (new body and join add, cut removes, intersect keeps)."""
     if operation == "cut":
         return canvas & ~zones
     if operation == "intersect":
@@ -127,7 +128,7 @@ def ground_truth(
     for i, (tool, operation) in enumerate(zip(tools, operations, strict=True)):
         zones, error = map_tool(graph, tool)
         step = GTStep(i, operation, zones, canvas, error, bool(error <= MAPPING_RTOL))
-        after = _apply(operation, canvas, zones)
+        after = apply_operation(operation, canvas, zones)
         for level, gen in generators.items():
             _test_capture(step, gen, level, after)
         steps.append(step)

@@ -22,7 +22,7 @@ from OCP.ShapeFix import ShapeFix_Shape, ShapeFix_ShapeTolerance
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SHAPE, TopAbs_SOLID
 
 from zonegraph.errors import is_kernel_error
-from zonegraph.geometry.cells import select_cells
+from zonegraph.geometry.cells import FUZZY_SHARES, cells_by_fuzzy
 from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, precise_volume
 from zonegraph.geometry.shapes import volume_of
 from zonegraph.geometry.vec import vec3
@@ -197,11 +197,6 @@ def _step(shape: Shape, tools: list[Shape], ops: list[Op], by_cells: bool) -> tu
     return combined, False
 
 
-# Fuzzy values of the rebuild's Booleans, as shares of the part's bounding-box diagonal, tried in
-# turn after an exact Boolean fails or returns an invalid solid.
-FUZZY_SHARES = (0.0, 1e-7, 1e-5)
-
-
 def _combine(shape: Shape, tool: Shape, op: Op) -> Shape | None:
     """``shape`` fused with or cut by ``tool``, trying in turn: the operands as they are, the tool
     repaired, fuzzy values, and the part so far repaired. The first result the checker accepts
@@ -228,11 +223,8 @@ def _cells_rebuild(ops: list[Op], tools: list[Shape], diag: float) -> Shape | No
     (the measured cases: ``docs/results/evidence.md``). The first result the checker accepts
     wins, else the first with volume; None when every fuse failed."""
     first = None
-    for share in FUZZY_SHARES:
-        try:
-            result = Shape.cast(select_cells([t.wrapped for t in tools], partial(_kept, ops), share * diag))
-        except RuntimeError:
-            continue
+    for cells in cells_by_fuzzy([t.wrapped for t in tools], partial(_kept, ops), diag):
+        result = Shape.cast(cells)
         if not result.volume > 0:
             continue
         if result.is_valid:
