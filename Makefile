@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 TORCH_SPEC ?= torch==2.13.0
 STAMP := $(VENV)/.installed
 
-.PHONY: install run test lint bench ui clean
+.PHONY: install run test lint docs docs-build bench ui clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,8 +22,16 @@ install: $(STAMP)
 run: $(STAMP)
 	PATH="$(abspath $(BIN)):$$PATH" $(BIN)/dvc repro
 
-test: $(STAMP) lint
+test: $(STAMP) lint docs-build
 	$(BIN)/python -m pytest -q
+
+# The documentation site (docs/, mkdocs.yml): `make docs` serves it on http://127.0.0.1:8000;
+# `make test` builds it with --strict, so a broken link or a missing API reference fails CI.
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs serve
+
+docs-build: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet --site-dir $(VENV)/site
 
 # ruff (style, imports, line length) and mypy (every zonegraph function fully annotated)
 lint: $(STAMP)
@@ -40,4 +48,4 @@ ui: $(STAMP)
 	$(BIN)/mlflow ui --backend-store-uri sqlite:///mlflow.db --port $${PORT:-5000}
 
 clean:
-	rm -rf $(VENV) data mlruns
+	rm -rf $(VENV) data mlruns site

@@ -6,7 +6,7 @@ step. Designs of ``labels.rank_splits`` (the test split) get rank-only labels in
 proposal of every captured step with the GT flagged and no completions (multiplier 0), which is
 what the relative GT rank of ``eval`` needs at a small part of the cost. Each design is one
 killable Dask task that writes its own shards, ``data/labels/proposals/<id>.parquet`` and
-``data/labels/steps/<id>.parquet`` (schemas in the README; read the folders with
+``data/labels/steps/<id>.parquet`` (schemas in docs/pipeline.md; read the folders with
 ``pyarrow.dataset``), so one bad design never loses the others and an interrupted run resumes.
 ``data/metrics/labels.json`` counts designs, steps and labels (rank-only designs apart).
 """

@@ -1,4 +1,4 @@
-"""The package's layers: imports run one way, the public API is where the README says it is."""
+"""The package's layers: imports run one way, the public API is where the docs say it is."""
 
 from __future__ import annotations
 
@@ -140,11 +140,10 @@ def test_every_subpackage_declares_its_api():
         assert any(t.id == "__all__" for n in names for t in n.targets if isinstance(t, ast.Name)), init
 
 
-def test_the_readme_layout_names_every_module():
-    """The README's Layout section matches the tree: every sub-package and every module of the
+def test_the_layout_page_names_every_module():
+    """The docs' code layout page matches the tree: every sub-package and every module of the
     package (a sub-package's modules by their own name) is named there."""
-    readme = (PACKAGE.parent / "README.md").read_text()
-    layout = readme.split("## Layout", 1)[1].split("\n## ", 1)[0]
+    layout = (PACKAGE.parent / "docs" / "layout.md").read_text()
     named = set(re.findall(r"`([\w/.]+?)/?`", layout))
     missing = []
     for path in sorted(PACKAGE.rglob("*.py")):
@@ -152,4 +151,4 @@ def test_the_readme_layout_names_every_module():
         name = parts[-2] if parts[-1] == "__init__" and len(parts) > 1 else parts[-1]
         if name != "__init__" and name not in named and f"zonegraph/{name}" not in named:
             missing.append("/".join(parts))
-    assert not missing, f"modules the README's Layout does not name: {missing}"
+    assert not missing, f"modules docs/layout.md does not name: {missing}"

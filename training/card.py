@@ -70,7 +70,7 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
         "",
         f"- git commit `{origin.get('git_commit', '?')}`, MLflow run `{origin.get('run_id', '?')}`",
         "- trained by `python -m training.train --params PARAMS` (the `train` section above) after "
-        "the `labels` stage; see the README, *The network guide*.",
+        "the `labels` stage; see docs/network.md.",
     ]
     if note:
         lines += ["", note]
