@@ -1,0 +1,107 @@
+"""Figures for the documentation, written from the benchmarks' own results.
+
+    python -m bench.figures corpus NAME RESULTS.json --command "python -m bench.corpus_bench ..." \
+        [--commit SHA] [--out docs/figures]
+    python -m bench.figures fusion-diff NAME RESULTS.json --command "..." [--commit SHA]
+
+A results page never carries a number typed by hand: a benchmark's ``results.json`` (its per-design
+rows, or its summary) is reduced here to a small figure file, ``docs/figures/NAME.json``, holding
+the figure with the command and the commit that measured it, and the site's hook
+(``docs/hooks/figures.py``) renders ``<!-- figure: ... -->`` markers in the pages from those files.
+Re-running a benchmark and this command is how a page's numbers change.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+from datetime import date
+from pathlib import Path
+
+import numpy as np
+
+from zonegraph.status import Status
+
+FIGURES = Path("docs/figures")
+EXACT_IOU = 0.9999
+SEARCHED = (Status.EXACT, Status.PARTIAL, Status.REBUILD_FAILED)
+
+
+def _group(rows: list[dict]) -> dict:
+    """Counts of one folder's rows: drawn, converted, zone graph built and searched, exact."""
+    converted = [r for r in rows if not str(r.get("status", "")).startswith("convert_")]
+    searched = [r for r in converted if r.get("status") in SEARCHED]
+    return {
+        "drawn": len(rows),
+        "converted": len(converted),
+        "zone_graph": len(searched),
+        "exact": sum(bool(r.get("exact")) for r in searched),
+        "mean_iou_brep": round(float(np.mean([r.get("iou_brep", 0.0) for r in searched])), 4)
+        if searched
+        else None,
+    }
+
+
+def corpus_figure(rows: list[dict]) -> dict:
+    """The corpus benchmark's figure: counts by folder and overall, the largest search wall past
+    its budget, and the zone-exact programs whose B-rep, JSON or script is not exact."""
+    folders = sorted({r["folder"] for r in rows})
+    timed = [r for r in rows if "search_s" in r and r.get("config")]
+    overrun = max((r["search_s"] / r["config"]["budget_s"] - 1 for r in timed), default=None)
+    zone_exact = [r for r in rows if r.get("iou_zone", 0.0) >= EXACT_IOU]
+    lost = [
+        r["design_id"]
+        for r in zone_exact
+        if min(r.get("iou_brep", 0.0), r.get("json_iou", 0.0), r.get("script_iou", 0.0)) < EXACT_IOU
+    ]
+    return {
+        "folders": {f: _group([r for r in rows if r["folder"] == f]) for f in folders},
+        "all": _group(rows),
+        "largest_overrun": None if overrun is None else round(overrun, 4),
+        "zone_exact": len(zone_exact),
+        "zone_exact_files_not_exact": lost,
+    }
+
+
+def head_commit() -> str:
+    out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    return out.stdout.strip() or "unknown"
+
+
+def write_figure(
+    kind: str, name: str, figure: dict, command: str, commit: str, measured: str, out: Path
+) -> Path:
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / f"{name}.json"
+    record = {
+        "kind": kind,
+        "name": name,
+        "command": command,
+        "commit": commit,
+        "measured": measured,
+        "figure": figure,
+    }
+    path.write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")
+    return path
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("kind", choices=["corpus", "fusion-diff"])
+    ap.add_argument("name", help="the figure's file name under --out, without .json")
+    ap.add_argument("results", type=Path, help="the benchmark's results.json")
+    ap.add_argument("--command", required=True, help="the command that wrote RESULTS")
+    ap.add_argument("--commit", default=None, help="the commit it measured (default: HEAD)")
+    ap.add_argument("--measured", default=date.today().isoformat(), help="the day it ran (default: today)")
+    ap.add_argument("--out", type=Path, default=FIGURES)
+    args = ap.parse_args()
+    data = json.loads(args.results.read_text())
+    figure = corpus_figure(data) if args.kind == "corpus" else data
+    commit = args.commit or head_commit()
+    path = write_figure(args.kind, args.name, figure, args.command, commit, args.measured, args.out)
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()

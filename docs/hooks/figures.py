@@ -1,0 +1,108 @@
+"""MkDocs hook: results tables rendered from the figure files the benchmarks wrote.
+
+A page writes ``<!-- figure: KIND NAME ... -->`` where a table belongs; the hook replaces it with
+the table drawn from ``docs/figures/NAME.json`` (written by ``python -m bench.figures``), each
+table followed by the command and commit that measured it. An unknown kind or a missing figure
+file stops the build, so ``mkdocs build --strict`` in ``make test`` fails rather than publishing a
+stale or invented number.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Callable
+from pathlib import Path
+
+FIGURES = Path(__file__).resolve().parents[1] / "figures"
+MARKER = re.compile(r"<!--\s*figure:\s*([\w-]+)((?:\s+[\w.-]+)+)\s*-->")
+
+
+def _load(name: str) -> dict:
+    path = FIGURES / f"{name}.json"
+    if not path.is_file():
+        raise ValueError(f"figure file {path} does not exist (write it with python -m bench.figures)")
+    return json.loads(path.read_text())
+
+
+def _rate(n: int, d: int) -> str:
+    return f"{n}/{d} ({n / d:.1%})" if d else "-"
+
+
+def _sources(records: list[dict]) -> str:
+    return "\n".join(f"- {r['name']}: `{r['command']}` at {r['commit']} ({r['measured']})" for r in records)
+
+
+def _row(label: str, cells: list[str]) -> str:
+    return f"| {label} | " + " | ".join(cells) + " |"
+
+
+def corpus_exact(records: list[dict]) -> str:
+    """Exact designs by timeline folder, one column per run, rates of the designs that converted."""
+    folders = sorted({f for r in records for f in r["figure"]["folders"]})
+    figures = [r["figure"] for r in records]
+    lines = [_row("folder", [r["name"] for r in records]), "|---" * (len(records) + 1) + "|"]
+    for f in folders:
+        groups = [x["folders"].get(f) for x in figures]
+        lines.append(
+            _row(f, [_rate(g["exact"], g["converted"]) if g and g["converted"] else "(none)" for g in groups])
+        )
+    alls = [x["all"] for x in figures]
+    lines += [
+        _row("**all, of converted**", [f"**{_rate(a['exact'], a['converted'])}**" for a in alls]),
+        _row("all, of drawn", [_rate(a["exact"], a["drawn"]) for a in alls]),
+        _row("zone graph built, of converted", [_rate(a["zone_graph"], a["converted"]) for a in alls]),
+        _row(
+            "largest search wall past budget",
+            ["-" if x["largest_overrun"] is None else f"{x['largest_overrun']:+.1%}" for x in figures],
+        ),
+        _row(
+            "zone-exact programs not exact as B-rep, JSON or script",
+            [f"{len(x['zone_exact_files_not_exact'])} of {x['zone_exact']}" for x in figures],
+        ),
+    ]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def fusion_diff(records: list[dict]) -> str:
+    """Our replay against Fusion's published figures, by decade, and later-stage failure rates."""
+    (r,) = records
+    f = r["figure"]
+    keys = sorted(
+        set(f["volume_decades"]) | set(f["area_decades"]),
+        key=lambda k: -99 if k.startswith("<") else (99 if k == "-" else int(k[2:])),
+    )
+    lines = [
+        f"{f['designs']} designs, {f['converted']} converted; {f['above']} of the converted differ "
+        "from Fusion by more than 1e-6 in volume or area.",
+        "",
+        "| relative difference, our replay vs Fusion | volume | area |",
+        "|---|---|---|",
+        *(f"| {k} | {f['volume_decades'].get(k, 0)} | {f['area_decades'].get(k, 0)} |" for k in keys),
+        "",
+        "| later stage | group | designs | failed | rate |",
+        "|---|---|---|---|---|",
+        *(
+            f"| {x['stage']} | {x['group']} | {x['designs']} | {x['failed']} | "
+            f"{'-' if x['rate'] is None else format(x['rate'], '.1%')} |"
+            for x in f["failure_rates"]
+        ),
+    ]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+RENDERERS: dict[str, Callable[[list[dict]], str]] = {"corpus-exact": corpus_exact, "fusion-diff": fusion_diff}
+
+
+def render(markdown: str) -> str:
+    def table(match: re.Match) -> str:
+        kind, names = match.group(1), match.group(2).split()
+        if kind not in RENDERERS:
+            raise ValueError(f"unknown figure kind {kind!r} (known: {', '.join(RENDERERS)})")
+        return RENDERERS[kind]([_load(n) for n in names])
+
+    return MARKER.sub(table, markdown)
+
+
+def on_page_markdown(markdown: str, **_: object) -> str:
+    return render(markdown)
