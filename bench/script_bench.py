@@ -202,9 +202,10 @@ def main() -> None:
         print(f"  {n}/{len(jobs)} {path.stem}: {row.get('style', row.get('skipped'))}", flush=True)
     scripts = {r["design_id"]: r.pop("script") for r in rows if "script" in r}
     write_results(rows, table(rows), args.out)
-    shown = [r for r in rows if r.get("objects")][: args.show]
+    with_objects = [r for r in rows if r.get("objects")]
+    shown = (with_objects[:1] + sorted(with_objects[1:], key=lambda r: -r["objects"]))[: args.show]
     paths = {r["design_id"]: p for p, _ in jobs for r in shown if p.stem == r["design_id"]}
-    before = {i: args.out / f"{i}.before.py" for i in paths}
+    before = {i: args.out.resolve() / f"{i}.before.py" for i in paths}
     write_before(args.before, [(paths[i], before[i]) for i in paths])
     for i in paths:
         pair = args.out / f"{i}.side_by_side.txt"

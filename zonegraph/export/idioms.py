@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -103,9 +103,20 @@ class SketchObject:
         return [f"with Locations(({written(self.centre[0])}, {written(self.centre[1])})):", f"    {call}"]
 
 
-def _num(x: float) -> float:
-    """``x`` as the script will read it back."""
-    return float(written(x))
+@dataclass(frozen=True)
+class Tolerance:
+    """``snap``: how far a derived number (a centre, a radius) may be shortened, as the snapper
+    shortens the loop's own; ``match``: how far the object's corners may lie from the loop's
+    (three times ``snap``: each written corner moved up to ``snap`` per coordinate, the object's
+    numbers once more)."""
+
+    snap: float
+    match: float
+
+
+def _short(x: float, tol: Tolerance) -> float:
+    """A derived number as the script will read it back, shortened like the loop's own numbers."""
+    return float(written(simplest(x, tol.snap)))
 
 
 def _match(points: Sequence[np.ndarray], expected: Sequence[np.ndarray], tol: float) -> bool:
@@ -122,25 +133,27 @@ def _match(points: Sequence[np.ndarray], expected: Sequence[np.ndarray], tol: fl
     return True
 
 
-def _circle(edges: Sequence[LocalEdge], tol: float) -> SketchObject | None:
+def _circle(edges: Sequence[LocalEdge], tol: Tolerance) -> SketchObject | None:
     if len(edges) != 1 or edges[0].kind != "circle":
         return None
     centre = edges[0].points[0]
-    return SketchObject(f"Circle({written(edges[0].radius)})", (_num(centre[0]), _num(centre[1])))
+    return SketchObject(
+        f"Circle({written(edges[0].radius)})", (_short(centre[0], tol), _short(centre[1], tol))
+    )
 
 
-def _rectangle(edges: Sequence[LocalEdge], tol: float) -> SketchObject | None:
+def _rectangle(edges: Sequence[LocalEdge], tol: Tolerance) -> SketchObject | None:
     """Four lines along the sketch axes."""
     if len(edges) != 4 or any(e.kind != "line" for e in edges):
         return None
     corners = [e.points[0] for e in edges]
     lo, hi = np.min(corners, axis=0), np.max(corners, axis=0)
-    w, h = _num(hi[0] - lo[0]), _num(hi[1] - lo[1])
-    if min(w, h) <= tol:
+    w, h = _short(hi[0] - lo[0], tol), _short(hi[1] - lo[1], tol)
+    if min(w, h) <= tol.match:
         return None
-    cx, cy = _num((lo[0] + hi[0]) / 2), _num((lo[1] + hi[1]) / 2)
+    cx, cy = _short((lo[0] + hi[0]) / 2, tol), _short((lo[1] + hi[1]) / 2, tol)
     expected = [np.array((cx + sx * w / 2, cy + sy * h / 2)) for sx in (-1, 1) for sy in (-1, 1)]
-    if not _match(corners, expected, tol):
+    if not _match(corners, expected, tol.match):
         return None
     return SketchObject(f"Rectangle({written(w)}, {written(h)})", (cx, cy))
 
@@ -150,7 +163,7 @@ def _degrees(angle: float, length: float, tol: float) -> float:
     return simplest(math.degrees(angle), math.degrees(tol / length) if length > 0 else 0.0)
 
 
-def _slot(edges: Sequence[LocalEdge], tol: float) -> SketchObject | None:
+def _slot(edges: Sequence[LocalEdge], tol: Tolerance) -> SketchObject | None:
     """Line, half circle, line, half circle: two equal half circles joined by their tangents."""
     kinds = [e.kind for e in edges]
     if len(edges) != 4 or sorted(kinds) != ["arc", "arc", "line", "line"] or kinds[0] == kinds[1]:
@@ -159,19 +172,21 @@ def _slot(edges: Sequence[LocalEdge], tol: float) -> SketchObject | None:
     centres = [np.asarray(e.curve.center, float)[:2] for e in arcs]  # type: ignore[union-attr]
     axis = centres[1] - centres[0]
     separation = float(np.linalg.norm(axis))
-    if separation <= tol:
+    if separation <= tol.match:
         return None
-    height = _num(arcs[0].radius + arcs[1].radius)
-    rotation = _degrees(math.atan2(axis[1], axis[0]) % math.pi, separation, tol)
+    height = _short(arcs[0].radius + arcs[1].radius, tol)
+    rotation = _degrees(math.atan2(axis[1], axis[0]) % math.pi, separation, tol.snap)
     turn = math.radians(rotation)
     u = np.array((math.cos(turn), math.sin(turn)))
     n = np.array((-u[1], u[0]))
-    sep = _num(separation)
-    mid = np.array((_num((centres[0][0] + centres[1][0]) / 2), _num((centres[0][1] + centres[1][1]) / 2)))
+    sep = _short(separation, tol)
+    mid = np.array(
+        (_short((centres[0][0] + centres[1][0]) / 2, tol), _short((centres[0][1] + centres[1][1]) / 2, tol))
+    )
     ends = [mid + s * sep / 2 * u for s in (-1, 1)]
     expected = [end + t * height / 2 * n for end in ends for t in (-1, 1)]
     expected += [ends[0] - height / 2 * u, ends[1] + height / 2 * u]
-    if not _match([q for e in arcs for q in e.points], expected, tol):
+    if not _match([q for e in arcs for q in e.points], expected, tol.match):
         return None
     return SketchObject(
         f"SlotCenterToCenter({written(sep)}, {written(height)}"
@@ -180,25 +195,25 @@ def _slot(edges: Sequence[LocalEdge], tol: float) -> SketchObject | None:
     )
 
 
-def _regular_polygon(edges: Sequence[LocalEdge], tol: float) -> SketchObject | None:
+def _regular_polygon(edges: Sequence[LocalEdge], tol: Tolerance) -> SketchObject | None:
     """Three or more equal lines whose corners lie evenly on one circle."""
     n = len(edges)
     if not 3 <= n <= MAX_POLYGON_SIDES or any(e.kind != "line" for e in edges):
         return None
     corners = np.array([e.points[0][:2] for e in edges])
-    centre = np.array([_num(c) for c in corners.mean(axis=0)])
-    radius = _num(float(np.mean(np.linalg.norm(corners - centre, axis=1))))
-    if radius <= tol:
+    centre = np.array([_short(c, tol) for c in corners.mean(axis=0)])
+    radius = _short(float(np.mean(np.linalg.norm(corners - centre, axis=1))), tol)
+    if radius <= tol.match:
         return None
     first = corners[0] - centre
-    rotation = _degrees(math.atan2(first[1], first[0]) % (2 * math.pi / n), radius, tol)
+    rotation = _degrees(math.atan2(first[1], first[0]) % (2 * math.pi / n), radius, tol.snap)
     turn = math.radians(rotation)
     expected = [
         centre
         + radius * np.array((math.cos(turn + 2 * math.pi * i / n), math.sin(turn + 2 * math.pi * i / n)))
         for i in range(n)
     ]
-    if not _match(list(corners), expected, tol):
+    if not _match(list(corners), expected, tol.match):
         return None
     args = [written(radius), str(n)]
     if written(rotation) != "0":
@@ -208,7 +223,7 @@ def _regular_polygon(edges: Sequence[LocalEdge], tol: float) -> SketchObject | N
     return SketchObject(f"RegularPolygon({', '.join(args)})", (float(centre[0]), float(centre[1])))
 
 
-RECOGNISERS: tuple[Callable[[Sequence[LocalEdge], float], SketchObject | None], ...] = (
+RECOGNISERS: tuple[Callable[[Sequence[LocalEdge], Tolerance], SketchObject | None], ...] = (
     _circle,
     _rectangle,
     _slot,
@@ -216,12 +231,39 @@ RECOGNISERS: tuple[Callable[[Sequence[LocalEdge], float], SketchObject | None], 
 )
 
 
+def _merged(edges: Sequence[LocalEdge], tol: float) -> list[LocalEdge]:
+    """The loop with each run of collinear lines as one line (a side split at a point, as
+    build123d's own slot is), corners within ``tol`` of the merged line."""
+    out = list(edges)
+    i = 0
+    while len(out) > 3 and i < len(out):
+        a, b = out[i], out[(i + 1) % len(out)]
+        if a.kind == b.kind == "line" and _on_segment(a.points[1], a.points[0], b.points[1], tol):
+            out[i] = replace(a, points=np.array([a.points[0], b.points[1]]))
+            out.pop((i + 1) % len(out))
+            i = 0
+            continue
+        i += 1
+    return out
+
+
+def _on_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray, tol: float) -> bool:
+    """Whether ``p`` lies within ``tol`` of the segment from ``a`` to ``b``, strictly between them."""
+    ab, ap = (b - a)[:2], (p - a)[:2]
+    length = float(np.linalg.norm(ab))
+    if length <= tol:
+        return False
+    t = float(ap @ ab) / length**2
+    return 0 < t < 1 and abs(float(ab[0] * ap[1] - ab[1] * ap[0])) / length <= tol
+
+
 def sketch_object(edges: Sequence[LocalEdge], tol: float) -> SketchObject | None:
     """The build123d object a loop is (its corners within ``tol`` of the object's), or None."""
     size = max((float(np.abs(e.points[:, :2]).max()) for e in edges), default=0.0)
-    tol = max(tol, MIN_TOL * max(size, 1.0))
+    tolerance = Tolerance(tol, max(3 * tol, MIN_TOL * max(size, 1.0)))
+    edges = _merged(edges, tolerance.match)
     for recognise in RECOGNISERS:
-        found = recognise(edges, tol)
+        found = recognise(edges, tolerance)
         if found is not None:
             return found
     return None
