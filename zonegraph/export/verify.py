@@ -117,10 +117,12 @@ def check_export(script: str, design: str, name: str, target: Shape) -> ExportCh
 
 
 def _styled_script(
-    steps: list[WrittenStep], name: str, unit: Unit, target: Shape, floor: float
+    steps: list[WrittenStep], name: str, unit: Unit, target: Shape, floor: float, reference: float
 ) -> tuple[str, ScriptStyle, float, str]:
-    """The most idiomatic script of ``steps`` that rebuilds to ``floor``; where none does, the best
-    (the more idiomatic within ``IOU_SLACK``). Returns the text, its style, IoU and error."""
+    """The most idiomatic script of ``steps`` that rebuilds as well as the program (to
+    ``reference`` within ``IOU_SLACK``: an idiom may not spend the margin between the program and
+    the exactness bar), the literal one to ``floor``; where none does, the best (the more
+    idiomatic within ``IOU_SLACK``). Returns the text, its style, IoU and error."""
     tried: list[tuple[str, ScriptStyle, float, str]] = []
     for style in STYLES:
         script = program_script(steps, name, unit, style)
@@ -128,19 +130,25 @@ def _styled_script(
             continue
         iou, error = _measure(partial(run_script, script), target, _fuzzy(target), "sequence.py")
         tried.append((script, style, iou, error))
-        if not error and iou >= floor:
+        if not error and iou >= (floor if style == LITERAL else max(floor, reference - IOU_SLACK)):
             return tried[-1]
     best = max(t[2] for t in tried)
     return next(t for t in tried if t[2] >= best - IOU_SLACK)
 
 
 def _pass(
-    program: list[ProgramStep], name: str, unit: Unit, target: Shape, snap: Snapper, floor: float
+    program: list[ProgramStep],
+    name: str,
+    unit: Unit,
+    target: Shape,
+    snap: Snapper,
+    floor: float,
+    reference: float,
 ) -> Export:
     """The files of one pass of ``snap`` over the program's numbers, the script in its best style."""
     steps = written_steps(program, snap)
     design = design_text(steps, name)
-    script, style, script_iou, script_error = _styled_script(steps, name, unit, target, floor)
+    script, style, script_iou, script_error = _styled_script(steps, name, unit, target, floor, reference)
     json_iou, json_error = _measure(
         lambda: replay(parse_design(json.loads(design), name)).shape, target, _fuzzy(target), "sequence.json"
     )
@@ -190,8 +198,8 @@ def verified_export(
         rel_tol: how far snapping may move a number, as a fraction of the part's diagonal.
     """
     floor = min(reference_iou - IOU_SLACK, exact_iou)
-    snapped = _pass(program, name, unit, target, _snapper(target, rel_tol), floor)
+    snapped = _pass(program, name, unit, target, _snapper(target, rel_tol), floor, reference_iou)
     if not snapped.snapped or as_good(snapped.check, floor):
         return snapped
-    raw = _pass(program, name, unit, target, Snapper.raw(), floor)
+    raw = _pass(program, name, unit, target, Snapper.raw(), floor, reference_iou)
     return snapped if as_good(snapped.check, floor, raw.check) else raw
