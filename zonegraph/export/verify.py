@@ -120,9 +120,10 @@ def _styled_script(
     steps: list[WrittenStep], name: str, unit: Unit, target: Shape, floor: float, reference: float
 ) -> tuple[str, ScriptStyle, float, str]:
     """The most idiomatic script of ``steps`` that rebuilds as well as the program (to
-    ``reference`` within ``IOU_SLACK``: an idiom may not spend the margin between the program and
-    the exactness bar), the literal one to ``floor``; where none does, the best (the more
-    idiomatic within ``IOU_SLACK``). Returns the text, its style, IoU and error."""
+    ``reference`` within ``IOU_SLACK``) or, measured beside the literal script, as well as that:
+    an idiom may not spend the margin between the program and the exactness bar. Where none
+    rebuilds to ``reference``, the best of all styles (the more idiomatic within ``IOU_SLACK``).
+    Returns the text, its style, IoU and error."""
     tried: list[tuple[str, ScriptStyle, float, str]] = []
     for style in STYLES:
         script = program_script(steps, name, unit, style)
@@ -130,7 +131,7 @@ def _styled_script(
             continue
         iou, error = _measure(partial(run_script, script), target, _fuzzy(target), "sequence.py")
         tried.append((script, style, iou, error))
-        if not error and iou >= (floor if style == LITERAL else max(floor, reference - IOU_SLACK)):
+        if not error and iou >= max(floor, reference - IOU_SLACK):
             return tried[-1]
     best = max(t[2] for t in tried)
     return next(t for t in tried if t[2] >= best - IOU_SLACK)
