@@ -1,6 +1,8 @@
 """Export of a found program: an editable build123d script, Fusion-format JSON, STEP and PNG.
 
 ``writers`` maps the program back to the input's units and frame and writes every file;
+``idioms`` chooses build123d's named planes and the sketch objects (Rectangle, Circle, ...) a
+profile is;
 ``render`` draws the step strip (green: union, red: subtraction, grey: the shape so far);
 ``snap`` shortens the written numbers and ``verify`` keeps them only where the written files still
 rebuild the part.

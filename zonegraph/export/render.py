@@ -1,4 +1,5 @@
-"""A PNG strip of a modeling sequence: grey is the shape so far, green a union, red a subtraction."""
+"""A PNG strip of a modeling sequence: grey is the shape so far, green a union, red a subtraction;
+an inferred program's strip ends on its final shape, so the result is seen without the tools."""
 
 from __future__ import annotations
 
@@ -51,10 +52,11 @@ def _draw(ax: Any, tris: np.ndarray, colour: Sequence[float], alpha: float) -> N
 
 @dataclass(frozen=True)
 class StripStep:
-    """One panel of a strip: the shape before the step (grey), the step's tool and whether it cuts."""
+    """One panel of a strip: the shape before the step (grey), the step's tool and whether it cuts
+    (no tool: a panel of the shape alone, drawn opaque)."""
 
     before: Shape | None
-    tool: Shape
+    tool: Shape | None
     subtract: bool
     title: str
 
@@ -77,8 +79,11 @@ def render_strips(rows: dict[str, Sequence[StripStep]], path: Path) -> Path:
         for i, step in enumerate(row):
             ax = fig.add_subplot(len(rows), width, r * width + i + 1, projection="3d")
             if step.before is not None:
-                _draw(ax, _triangles(step.before, tol), COLOURS["shape"], 0.35)
-            _draw(ax, _triangles(step.tool, tol), COLOURS[Op.SUBTRACT if step.subtract else Op.UNION], 0.8)
+                _draw(ax, _triangles(step.before, tol), COLOURS["shape"], 0.35 if step.tool else 0.9)
+            if step.tool is not None:
+                _draw(
+                    ax, _triangles(step.tool, tol), COLOURS[Op.SUBTRACT if step.subtract else Op.UNION], 0.8
+                )
             for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=False):
                 setter(c - half, c + half)
             ax.set_axis_off()
@@ -90,7 +95,8 @@ def render_strips(rows: dict[str, Sequence[StripStep]], path: Path) -> Path:
 
 
 def render_sequence(program: list[ProgramStep], states: Sequence[Shape | None], path: Path) -> Path:
-    """The strip of one inferred program: panel i shows the shape after step i - 1 and step i's tool."""
+    """The strip of one inferred program: panel i shows the shape after step i - 1 and step i's tool;
+    a last panel the final shape."""
     steps = [
         StripStep(
             states[i - 1] if i > 0 else None,
@@ -100,4 +106,6 @@ def render_sequence(program: list[ProgramStep], states: Sequence[Shape | None], 
         )
         for i, step in enumerate(program)
     ]
+    if states and states[-1] is not None:
+        steps.append(StripStep(states[-1], None, False, "final shape"))
     return render_strips({"": steps}, path)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,6 +37,7 @@ from zonegraph.data.design import (
     Sketch,
     design_to_json,
 )
+from zonegraph.export.idioms import named_plane, plane_code, plane_of_frame, plane_phrase, sketch_object
 from zonegraph.export.loops import LoopEdge, loop_edges
 from zonegraph.export.render import render_sequence
 from zonegraph.export.snap import Snapper, written
@@ -55,10 +57,18 @@ SPLINE_SAMPLES = 24  # points the script's interpolating spline runs through
 def step_frame(step: ProgramStep, snap: Snapper | None = None) -> Frame:
     """The sketch frame of a step, with its numbers snapped.
 
-    x is the principal axis least along z, made orthogonal to z; after snapping, x is made
-    orthogonal to the snapped z again, so the frame stays orthonormal."""
+    A step along a principal axis is sketched on build123d's named plane of that axis
+    (:data:`~zonegraph.export.idioms.NAMED_PLANES`), whose coordinates are the input's own; its
+    normal can point against the extrusion (the written distance is then negative). Otherwise x is
+    the principal axis least along z, made orthogonal to z; after snapping, x is made orthogonal
+    to the snapped z again, so the frame stays orthonormal."""
     snap = snap or Snapper.raw()
     z = snap.direction(step.direction)
+    named = named_plane(z)
+    if named is not None:
+        normal = np.array(named.z_dir)
+        origin = snap.point(normal * float(np.asarray(step.origin, float) @ normal)) + 0.0
+        return Frame(vec3(origin), named.x_dir, named.y_dir, named.z_dir)
     helper = np.eye(3)[int(np.argmin(np.abs(z)))]
     x = snap.direction(helper - z * float(helper @ z))
     x = x - z * float(x @ z)
@@ -201,13 +211,15 @@ def face_wires(face: Face) -> list[tuple[bool, list[LoopEdge]]]:
 
 @dataclass(frozen=True)
 class WrittenStep:
-    """One step with the numbers that go into the files: frame, loops per sketch face, distance."""
+    """One step with the numbers that go into the files: frame, loops per sketch face, distance
+    (along the frame's z; negative where the extrusion runs against the sketch normal)."""
 
     op: Op
     frame: Frame
     faces: tuple[tuple[tuple[bool, tuple[LocalEdge, ...]], ...], ...]  # per face: (is_outer, edges)
     areas: tuple[float, ...]  # each sketch face's area (the JSON's profile area)
     distance: float
+    tol: float = 0.0  # how far the snapper could move a number (a sketch object matches within it)
 
 
 def written_steps(program: list[ProgramStep], snap: Snapper | None = None) -> list[WrittenStep]:
@@ -221,7 +233,8 @@ def written_steps(program: list[ProgramStep], snap: Snapper | None = None) -> li
             for f in step.faces
         )
         areas = tuple(f.area for f in step.faces)
-        out.append(WrittenStep(step.op, frame, faces, areas, snap.length(step.distance)))
+        sign = 1.0 if float(np.dot(step.direction, frame.z_axis)) > 0 else -1.0
+        out.append(WrittenStep(step.op, frame, faces, areas, sign * snap.length(step.distance), snap.tol))
     return out
 
 
@@ -246,44 +259,138 @@ def _edge_code(e: LocalEdge) -> str:
     return "Spline(" + ", ".join(_xy(p) for p in e.points) + ")  # interpolates the original curve"
 
 
-def _step_code(i: int, step: WrittenStep) -> list[str]:
-    frame = step.frame
-    verb = "union" if step.op is Op.UNION else "subtract"
-    lines = [
-        f"    # Step {i}: {verb}, extrude {written(step.distance)} along the sketch normal",
-        f"    with BuildSketch(Plane(origin={_vec(frame.origin)}, x_dir={_vec(frame.x_axis)}, "
-        f"z_dir={_vec(frame.z_axis)})):",
-    ]
+@dataclass(frozen=True)
+class ScriptStyle:
+    """Which idioms a script may use. :func:`zonegraph.export.verify.verified_export` drops them
+    (holes first, then objects) where the script they give does not rebuild the part as well."""
+
+    objects: bool = True  # loops as Circle, Rectangle, SlotCenterToCenter, RegularPolygon
+    holes: bool = True  # a cut of lone circles into a named plane as Hole
+
+
+IDIOMATIC = ScriptStyle()
+LITERAL = ScriptStyle(objects=False, holes=False)
+OBJECT_CALL = re.compile(r"^\s*(Circle|Rectangle|SlotCenterToCenter|RegularPolygon|Hole)\(", re.MULTILINE)
+
+
+def profile_counts(script: str) -> tuple[int, int]:
+    """(loops written as build123d objects, loops in all) of a script this module wrote (a Hole
+    counts once per location)."""
+    objects = 0
+    lines = script.splitlines()
+    for i, line in enumerate(lines):
+        if OBJECT_CALL.match(line):
+            above = lines[i - 1].strip() if i else ""
+            objects += above.count("), (") + 1 if above.startswith("with Locations((") else 1
+    return objects, objects + script.count("make_face(")
+
+
+def _where(step: WrittenStep, unit: str) -> tuple[str, str, str]:
+    """The plane's code, its description and the extrusion's direction in words."""
+    frame, origin = step.frame, step.frame.origin
+    named = plane_of_frame(frame.x_axis, frame.z_axis)
+    if named is None:
+        code = f"Plane(origin={_vec(origin)}, x_dir={_vec(frame.x_axis)}, z_dir={_vec(frame.z_axis)})"
+        return code, f"a plane through {_vec(origin)} {unit}", "along its normal"
+    axis = "xyz"[named.axis]
+    sign = "+" if (named.z_dir[named.axis] > 0) == (step.distance > 0) else "-"
+    return plane_code(named, origin), plane_phrase(named, origin, unit), f"along {sign}{axis}"
+
+
+def _hole_circles(step: WrittenStep) -> list[LocalEdge] | None:
+    """The circles of a cut into a named plane (against its normal) whose every face is one
+    circle, or None: build123d's Hole cuts along -z of its location."""
+    named = plane_of_frame(step.frame.x_axis, step.frame.z_axis)
+    if step.op is not Op.SUBTRACT or named is None or step.distance >= 0:
+        return None
+    circles = [loops[0][1][0] for loops in step.faces if len(loops) == 1 and len(loops[0][1]) == 1]
+    if len(circles) != len(step.faces) or any(c.kind != "circle" for c in circles):
+        return None
+    return circles
+
+
+def _hole_code(step: WrittenStep, circles: list[LocalEdge], plane: str) -> list[str]:
+    """Hole(r, depth=d) cuts d either side of its location: exact where nothing lies above the
+    plane within d (the rebuild check decides)."""
+    by_radius: dict[str, list[str]] = {}
+    for c in circles:
+        by_radius.setdefault(written(c.radius), []).append(_xy(c.points[0]))
+    lines = [f"    with Locations({plane}):"]
+    for radius, centres in by_radius.items():
+        lines += [
+            f"        with Locations({', '.join(centres)}):",
+            f"            Hole({radius}, depth={written(-step.distance)})",
+        ]
+    return lines
+
+
+def _sketch_code(step: WrittenStep, style: ScriptStyle) -> list[str]:
+    lines = []
     for loops in step.faces:
         for outer, edges in loops:
+            found = sketch_object(edges, step.tol) if style.objects else None
+            if found is not None:
+                lines += [f"        {line}" for line in found.lines(subtract=not outer)]
+                continue
             lines.append("        with BuildLine(mode=Mode.PRIVATE) as loop:")
             lines += [f"            {_edge_code(e)}" for e in edges]
             mode = "" if outer else ", mode=Mode.SUBTRACT"
             lines.append(f"        make_face(loop.edges(){mode})")
+    return lines
+
+
+def _step_code(i: int, step: WrittenStep, unit: str, style: ScriptStyle) -> list[str]:
+    verb = "union" if step.op is Op.UNION else "subtract"
+    plane, where, direction = _where(step, unit)
+    depth = f"{written(abs(step.distance))} {unit}"
+    circles = _hole_circles(step) if style.holes else None
+    if circles is not None:
+        count = f"{len(circles)} holes" if len(circles) > 1 else "a hole"
+        return [f"    # Step {i}: {count} {depth} deep into {where}", *_hole_code(step, circles, plane), ""]
     mode = "Mode.ADD" if step.op is Op.UNION else "Mode.SUBTRACT"
-    return lines + [f"    extrude(amount={written(step.distance)}, mode={mode})", ""]
+    return [
+        f"    # Step {i}: {verb}: sketch on {where}, extruded {depth} {direction}",
+        f"    with BuildSketch({plane}):",
+        *_sketch_code(step, style),
+        f"    extrude(amount={written(step.distance)}, mode={mode})",
+        "",
+    ]
 
 
-def program_script(steps: list[WrittenStep], name: str, unit: Unit) -> str:
+def program_script(steps: list[WrittenStep], name: str, unit: Unit, style: ScriptStyle = IDIOMATIC) -> str:
+    """The build123d script of a program: lengths in the input's unit, at the input's position."""
+    u = unit.name.lower()
     lines = [
         f'"""{name}: {len(steps)} sketch + extrude steps found by `zonegraph infer`.',
         "",
-        f"Units ({unit.name.lower()}) and position are the input's. Run `python sequence.py [out.step]`.",
+        f"Lengths are in {u}, the input's unit, and the part sits where the input's did. Run",
+        "`python sequence.py [out.step]` to write it as STEP (default: sequence.step beside this",
+        "file); with no argument it is also shown in the OCP CAD Viewer where ocp_vscode is installed.",
         '"""',
         "",
         "import sys",
+        "from pathlib import Path",
         "",
         "from build123d import *",
         "",
         "with BuildPart() as part:",
     ]
     for i, step in enumerate(steps, 1):
-        lines += _step_code(i, step)
+        lines += _step_code(i, step, u, style)
     lines += [
         "result = part.part",
         "",
-        'if __name__ == "__main__" and len(sys.argv) > 1:',
-        f"    export_step(result, sys.argv[1], unit=Unit.{unit.name})",
+        'if __name__ == "__main__":',
+        '    out = sys.argv[1] if len(sys.argv) > 1 else str(Path(__file__).with_suffix(".step"))',
+        f"    export_step(result, out, unit=Unit.{unit.name})",
+        '    print(f"wrote {out}")',
+        "    if len(sys.argv) == 1:",
+        "        try:",
+        "            from ocp_vscode import show",
+        "        except ImportError:",
+        "            pass",
+        "        else:",
+        "            show(result)",
         "",
     ]
     return "\n".join(lines)
