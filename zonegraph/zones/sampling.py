@@ -29,7 +29,9 @@ INSIDE_RGBA = (70, 120, 220, 255)
 OUTSIDE_RGBA = (200, 200, 200, 60)
 
 
-def _surface_samples(corners: np.ndarray, area: np.ndarray, count: int, rng: np.random.Generator):
+def _surface_samples(
+    corners: np.ndarray, area: np.ndarray, count: int, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
     """``count`` points on triangles (T, 3, 3) weighted by ``area`` and the triangle of each: the
     draws of ``trimesh.sample.sample_surface`` (TrianglePointPicking), in its order."""
     weight_cum = np.cumsum(area)
