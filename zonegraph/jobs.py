@@ -1,20 +1,21 @@
 """Job bodies shared by the CLI and the pipeline; each runs in an isolated child process and
-returns only small plain data (the geometry goes to files)."""
+returns only small plain data (the geometry goes to files).
+
+The design replay and the corpus converter need build123d, which a zone-graph build does not, so
+their modules are imported by the jobs that use them: ``zonegraph build PART.step`` stays on OCP.
+"""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pyarrow.parquet as pq
 
 from zonegraph.configs import BuildConfig
-from zonegraph.data.b123d import ConvertedDesign, batch_entries, convert_design
-from zonegraph.data.design import load_design
-from zonegraph.data.replay import replay
-from zonegraph.data.targets import load_target
+from zonegraph.data.targets import load_kernel_target
 from zonegraph.errors import ReplayMismatchError
 from zonegraph.geometry.shapes import read_shape, read_solids, write_step
 from zonegraph.isolation import run_isolated
@@ -28,6 +29,9 @@ from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.sampling import export_zone_mesh
 from zonegraph.zones.storage import load_zone_graph, save_zone_graph
 
+if TYPE_CHECKING:
+    from zonegraph.data.b123d import ConvertedDesign
+
 
 def replay_and_save(design_path: str, out: Path, tolerance: float | None = None) -> dict[str, Any]:
     """Replay a design and write final.step, steps/ and summary.json (run in a killable child).
@@ -36,6 +40,9 @@ def replay_and_save(design_path: str, out: Path, tolerance: float | None = None)
         ReplayMismatchError: ``tolerance`` given and the result disagrees with the file's own
             properties beyond it (nothing is written).
     """
+    from zonegraph.data.design import load_design
+    from zonegraph.data.replay import replay
+
     design = load_design(design_path)
     result = replay(design)
     problem = None if tolerance is None else result.disagreement(tolerance)
@@ -63,8 +70,9 @@ def build_and_save(
         InputError: the file cannot be read as solids.
         ZoneGraphBuildError: the graph cannot be built or breaks an invariant.
     """
+    solids = load_kernel_target(target)
     graph = build_zone_graph(
-        load_target(target), simplify=config.simplify, samples=config.samples, seed=config.seed, source=target
+        solids, simplify=config.simplify, samples=config.samples, seed=config.seed, source=target
     )
     save_zone_graph(graph, out)
     if mesh:
@@ -202,6 +210,8 @@ def convert_isolated(
     """:func:`convert_design` in a forked child killed after ``timeout`` seconds: the design's
     endless C call, ``os._exit`` or segfault becomes a ``timeout`` or ``crash`` row, and a bug of
     ours a ``bug`` row (its traceback the first of its ``notes``)."""
+    from zonegraph.data.b123d import ConvertedDesign, convert_design
+
     args = (str(batch_path), design_id, fusion_volume, fusion_area)
     outcome = run_isolated(convert_design, args, timeout=timeout)
     if outcome.ok:
@@ -222,6 +232,8 @@ def convert_isolated(
 
 def convert_batch(batch_path: str | Path, timeout: float = 120.0) -> list[ConvertedDesign]:
     """Convert every model of a batch, in file order, each in its own killable child."""
+    from zonegraph.data.b123d import batch_entries
+
     path = Path(batch_path)
     return [
         convert_isolated(path, e.design_id, e.fusion_volume, e.fusion_area, timeout)

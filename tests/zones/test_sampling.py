@@ -44,3 +44,25 @@ def test_zone_mesh_export_opens_with_one_colour_per_side(tmp_path):
     colours = {tuple(c) for c in mesh.visual.face_colors.tolist()}
     assert len(colours) == 2  # inside and outside zones
     assert mesh.bounds[1] - mesh.bounds[0] == pytest.approx(g.box[3:] - g.box[:3], abs=1e-6)
+
+
+def test_samples_are_trimeshs_surface_sampler_draws():
+    """The numpy sampler keeps trimesh's draws, so a seed gives the samples it gave with trimesh."""
+    from zonegraph.zones.sampling import _surface_samples
+
+    rng = np.random.default_rng(5)
+    corners = rng.normal(size=(30, 3, 3))
+    area = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1) / 2
+    mesh = trimesh.Trimesh(vertices=corners.reshape(-1, 3), faces=np.arange(90).reshape(-1, 3), process=False)
+    ours, ours_faces = _surface_samples(corners, area, 500, np.random.default_rng(9))
+    seed = np.random.default_rng(9)
+    theirs, their_faces = trimesh.sample.sample_surface(mesh, 500, face_weight=area, seed=seed)
+    assert np.array_equal(ours_faces, their_faces)
+    assert np.array_equal(ours, theirs)
+
+
+def test_zone_mesh_file_reads_back_as_the_zone_triangles(tmp_path):
+    g = build_zone_graph(Box(2, 1, 1), samples=0)
+    mesh = trimesh.load(export_zone_mesh(g, tmp_path / "zones.ply"), process=False)
+    assert len(mesh.vertices) == 3 * len(mesh.faces)  # three corners per triangle, none merged
+    assert mesh.volume == pytest.approx(float(np.prod(g.box[3:] - g.box[:3])), rel=1e-6)  # outward

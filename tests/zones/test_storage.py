@@ -115,3 +115,30 @@ def test_cli_build_errors_are_one_line(tmp_path, args, message):
     assert proc.returncode == 2
     lines = [line for line in proc.stderr.splitlines() if line.startswith("zonegraph:")]
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr
+
+
+def test_a_step_target_is_read_by_the_kernel_alone_as_build123d_reads_it(samples_dir, tmp_path):
+    """``zonegraph build PART.step`` loads neither build123d nor trimesh nor scipy (each costs a
+    short command seconds and tens of MB), and reads the same solids as build123d's importer."""
+    from build123d import import_step
+
+    from zonegraph.data.targets import load_kernel_target
+
+    step = samples_dir / "Couch.step"
+    ours = load_kernel_target(step)
+    theirs = import_step(str(step)).solids()
+    assert [volume_props(s)[0] for s in ours] == pytest.approx([s.volume for s in theirs], rel=1e-12)
+    code = (
+        "import sys; from zonegraph.jobs import build_and_save\n"
+        f"build_and_save({str(step)!r}, {str(tmp_path / 'g')!r}, mesh=True)\n"
+        "print(sorted(m for m in ('build123d', 'trimesh', 'scipy') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["[]"]
+
+
+def test_component_count_joins_edges_in_any_order():
+    from zonegraph.zones.model import component_count
+
+    assert component_count(5, np.array([[3, 4], [0, 1], [4, 1]])) == 2  # {0, 1, 3, 4} and {2}
+    assert component_count(3, np.zeros((0, 2), int)) == 3

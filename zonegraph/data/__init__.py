@@ -9,25 +9,36 @@ replay function is :func:`zonegraph.data.replay.replay` (the module keeps its na
 only :mod:`zonegraph.geometry` and :mod:`zonegraph.errors`.
 """
 
-from zonegraph.data.dataset import DesignRecord, read_dataset
-from zonegraph.data.design import Design, Extrude, Operation, design_to_json, load_design, parse_design
-from zonegraph.data.replay import ReplayResult, ReplayStep, as_shape
-from zonegraph.data.synthetic import generate_design, synthetic_design
-from zonegraph.data.targets import load_target
+from __future__ import annotations
 
-__all__ = [
-    "Design",
-    "DesignRecord",
-    "Extrude",
-    "Operation",
-    "ReplayResult",
-    "ReplayStep",
-    "as_shape",
-    "design_to_json",
-    "generate_design",
-    "load_design",
-    "load_target",
-    "parse_design",
-    "read_dataset",
-    "synthetic_design",
-]
+from typing import TYPE_CHECKING
+
+from zonegraph.lazy import lazy_exports
+
+_EXPORTS = {
+    "DesignRecord": "zonegraph.data.dataset",
+    "read_dataset": "zonegraph.data.dataset",
+    "Design": "zonegraph.data.design",
+    "Extrude": "zonegraph.data.design",
+    "Operation": "zonegraph.data.design",
+    "design_to_json": "zonegraph.data.design",
+    "load_design": "zonegraph.data.design",
+    "parse_design": "zonegraph.data.design",
+    "ReplayResult": "zonegraph.data.replay",
+    "ReplayStep": "zonegraph.data.replay",
+    "as_shape": "zonegraph.data.replay",
+    "generate_design": "zonegraph.data.synthetic",
+    "synthetic_design": "zonegraph.data.synthetic",
+    "load_target": "zonegraph.data.targets",
+}
+
+__all__ = sorted(_EXPORTS)
+
+if TYPE_CHECKING:
+    from zonegraph.data.dataset import DesignRecord, read_dataset
+    from zonegraph.data.design import Design, Extrude, Operation, design_to_json, load_design, parse_design
+    from zonegraph.data.replay import ReplayResult, ReplayStep, as_shape
+    from zonegraph.data.synthetic import generate_design, synthetic_design
+    from zonegraph.data.targets import load_target
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, __all__)

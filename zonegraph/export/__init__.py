@@ -9,22 +9,39 @@ rebuild the part.
 Imports :mod:`zonegraph.sequence`, :mod:`zonegraph.data` and :mod:`zonegraph.geometry`.
 """
 
-from zonegraph.export.render import StripStep, render_sequence, render_strips
-from zonegraph.export.snap import Snapper
-from zonegraph.export.verify import Export, ExportCheck, verified_export
-from zonegraph.export.writers import WrittenStep, program_design, program_script, write_outputs, written_steps
+from __future__ import annotations
 
-__all__ = [
-    "Export",
-    "ExportCheck",
-    "Snapper",
-    "StripStep",
-    "WrittenStep",
-    "program_design",
-    "program_script",
-    "render_sequence",
-    "render_strips",
-    "verified_export",
-    "write_outputs",
-    "written_steps",
-]
+from typing import TYPE_CHECKING
+
+from zonegraph.lazy import lazy_exports
+
+_EXPORTS = {
+    "StripStep": "zonegraph.export.render",
+    "render_sequence": "zonegraph.export.render",
+    "render_strips": "zonegraph.export.render",
+    "Snapper": "zonegraph.export.snap",
+    "Export": "zonegraph.export.verify",
+    "ExportCheck": "zonegraph.export.verify",
+    "verified_export": "zonegraph.export.verify",
+    "WrittenStep": "zonegraph.export.writers",
+    "program_design": "zonegraph.export.writers",
+    "program_script": "zonegraph.export.writers",
+    "write_outputs": "zonegraph.export.writers",
+    "written_steps": "zonegraph.export.writers",
+}
+
+__all__ = sorted(_EXPORTS)
+
+if TYPE_CHECKING:
+    from zonegraph.export.render import StripStep, render_sequence, render_strips
+    from zonegraph.export.snap import Snapper
+    from zonegraph.export.verify import Export, ExportCheck, verified_export
+    from zonegraph.export.writers import (
+        WrittenStep,
+        program_design,
+        program_script,
+        write_outputs,
+        written_steps,
+    )
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, __all__)

@@ -6,34 +6,45 @@ backtracking, and ``program`` turns a found sequence into real sketches and extr
 with build123d. Imports :mod:`zonegraph.zones` and :mod:`zonegraph.geometry`.
 """
 
-from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
-from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou, build_program, execute
-from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
-from zonegraph.sequence.rankers import (
-    HeuristicRanker,
-    RandomRanker,
-    Ranker,
-    make_ranker,
-    relative_rank,
-    zone_iou,
-)
+from __future__ import annotations
 
-__all__ = [
-    "HeuristicRanker",
-    "Op",
-    "ProgramStep",
-    "Proposal",
-    "ProposalGenerator",
-    "RandomRanker",
-    "Ranker",
-    "RebuildError",
-    "SearchConfig",
-    "SearchResult",
-    "brep_iou",
-    "build_program",
-    "execute",
-    "make_ranker",
-    "relative_rank",
-    "search",
-    "zone_iou",
-]
+from typing import TYPE_CHECKING
+
+from zonegraph.lazy import lazy_exports
+
+_EXPORTS = {
+    "SearchConfig": "zonegraph.sequence.best_first",
+    "SearchResult": "zonegraph.sequence.best_first",
+    "search": "zonegraph.sequence.best_first",
+    "ProgramStep": "zonegraph.sequence.program",
+    "RebuildError": "zonegraph.sequence.program",
+    "brep_iou": "zonegraph.sequence.program",
+    "build_program": "zonegraph.sequence.program",
+    "execute": "zonegraph.sequence.program",
+    "Op": "zonegraph.sequence.proposals",
+    "Proposal": "zonegraph.sequence.proposals",
+    "ProposalGenerator": "zonegraph.sequence.proposals",
+    "HeuristicRanker": "zonegraph.sequence.rankers",
+    "RandomRanker": "zonegraph.sequence.rankers",
+    "Ranker": "zonegraph.sequence.rankers",
+    "make_ranker": "zonegraph.sequence.rankers",
+    "relative_rank": "zonegraph.sequence.rankers",
+    "zone_iou": "zonegraph.sequence.rankers",
+}
+
+__all__ = sorted(_EXPORTS)
+
+if TYPE_CHECKING:
+    from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
+    from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou, build_program, execute
+    from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
+    from zonegraph.sequence.rankers import (
+        HeuristicRanker,
+        RandomRanker,
+        Ranker,
+        make_ranker,
+        relative_rank,
+        zone_iou,
+    )
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, __all__)

@@ -6,17 +6,28 @@ draws the zones' surface samples and ``storage`` saves and loads a graph as Parq
 Imports only :mod:`zonegraph.geometry`, :mod:`zonegraph.errors` and :mod:`zonegraph.status`.
 """
 
-from zonegraph.zones.build import build_zone_graph
-from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
-from zonegraph.zones.sampling import export_zone_mesh, sample_zone_surfaces
-from zonegraph.zones.storage import load_zone_graph, save_zone_graph
+from __future__ import annotations
 
-__all__ = [
-    "ZoneGraph",
-    "ZoneGraphBuildError",
-    "build_zone_graph",
-    "export_zone_mesh",
-    "load_zone_graph",
-    "sample_zone_surfaces",
-    "save_zone_graph",
-]
+from typing import TYPE_CHECKING
+
+from zonegraph.lazy import lazy_exports
+
+_EXPORTS = {
+    "build_zone_graph": "zonegraph.zones.build",
+    "ZoneGraph": "zonegraph.zones.model",
+    "ZoneGraphBuildError": "zonegraph.zones.model",
+    "export_zone_mesh": "zonegraph.zones.sampling",
+    "sample_zone_surfaces": "zonegraph.zones.sampling",
+    "load_zone_graph": "zonegraph.zones.storage",
+    "save_zone_graph": "zonegraph.zones.storage",
+}
+
+__all__ = sorted(_EXPORTS)
+
+if TYPE_CHECKING:
+    from zonegraph.zones.build import build_zone_graph
+    from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
+    from zonegraph.zones.sampling import export_zone_mesh, sample_zone_surfaces
+    from zonegraph.zones.storage import load_zone_graph, save_zone_graph
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, __all__)

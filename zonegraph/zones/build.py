@@ -13,10 +13,9 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Callable, Iterator, Sequence
-from typing import Any, TypeAlias
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
-from build123d import Shape
 from OCP.BOPAlgo import BOPAlgo_Builder, BOPAlgo_MakerVolume
 from OCP.BOPTools import BOPTools_AlgoTools3D
 from OCP.BRepAdaptor import BRepAdaptor_Surface
@@ -63,6 +62,9 @@ from zonegraph.zones.model import (
     ZoneGraphBuildError,
 )
 from zonegraph.zones.sampling import sample_zone_surfaces
+
+if TYPE_CHECKING:
+    from build123d import Shape
 
 # Fuzzy values of the general fuse, in normalised units, tried in turn: 1e-7..1e-5 leave zone counts
 # unchanged where the fuse works at all, 1e-3 loses zones.

@@ -2,8 +2,11 @@
 
 Each zone's surface is the union of its partition faces' triangulations (normals outward). The
 samples are area-uniform points on that surface with the normal of the triangle they fall on,
-drawn by trimesh's surface sampler from a seeded generator; the same meshes, one colour per zone,
-make ``zones.ply`` for a viewer.
+drawn from a seeded generator by trimesh's surface sampler's draws (a face by cumulative area,
+then two uniform lengths folded into the triangle); the same meshes, one colour per zone, make
+``zones.ply`` for a viewer. Both are a few lines of numpy here rather than trimesh's: importing
+trimesh (and the scipy and networkx it loads) would cost every ``zonegraph build`` about 0.5 s
+and 40 MB for these two calls; the tests check both against trimesh itself.
 """
 
 from __future__ import annotations
@@ -12,7 +15,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
 
@@ -27,13 +29,18 @@ INSIDE_RGBA = (70, 120, 220, 255)
 OUTSIDE_RGBA = (200, 200, 200, 60)
 
 
-def triangle_mesh(corners: np.ndarray, rgba: tuple[int, int, int, int] | None = None) -> trimesh.Trimesh:
-    """Triangles given by their corners (T, 3, 3) as a trimesh, face order kept (no merging)."""
-    faces = np.arange(3 * len(corners)).reshape(-1, 3)
-    colours = np.tile(rgba, (len(corners), 1)) if rgba is not None else None
-    return trimesh.Trimesh(
-        vertices=corners.reshape(-1, 3), faces=faces, face_colors=colours, process=False, validate=False
-    )
+def _surface_samples(
+    corners: np.ndarray, area: np.ndarray, count: int, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
+    """``count`` points on triangles (T, 3, 3) weighted by ``area`` and the triangle of each: the
+    draws of ``trimesh.sample.sample_surface`` (TrianglePointPicking), in its order."""
+    weight_cum = np.cumsum(area)
+    face = np.searchsorted(weight_cum, rng.random(count) * weight_cum[-1])
+    origins = corners[:, 0][face]
+    vectors = (corners[:, 1:] - corners[:, :1])[face]
+    lengths = rng.random((count, 2, 1))
+    lengths[lengths.sum(axis=1).reshape(-1) > 1.0] -= 1.0
+    return (vectors * np.abs(lengths)).sum(axis=1) + origins, face
 
 
 def sample_zone_surfaces(
@@ -56,9 +63,27 @@ def sample_zone_surfaces(
     for z, (corners, n, area) in enumerate(zone_tris):
         if not len(area):
             continue
-        p, t = trimesh.sample.sample_surface(triangle_mesh(corners), count, face_weight=area, seed=rng)
+        p, t = _surface_samples(corners, area, count, rng)
         points[z], normals[z] = p, n[t]
     return points, normals
+
+
+def write_ply(path: Path, corners: np.ndarray, rgba: np.ndarray) -> None:
+    """Triangles (T, 3, 3) with a colour each (T, 4) as binary PLY, the layout trimesh writes
+    (float32 vertices, three per triangle, face order kept)."""
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {3 * len(corners)}\nproperty float x\nproperty float y\nproperty float z\n"
+        f"element face {len(corners)}\nproperty list uchar int vertex_indices\n"
+        "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n"
+        "end_header\n"
+    )
+    face = np.zeros(len(corners), [("n", "u1"), ("v", "<i4", 3), ("rgba", "u1", 4)])
+    face["n"], face["v"], face["rgba"] = 3, np.arange(3 * len(corners)).reshape(-1, 3), rgba
+    with open(path, "wb") as f:
+        f.write(header.encode("ascii"))
+        f.write(corners.reshape(-1, 3).astype("<f4").tobytes())
+        f.write(face.tobytes())
 
 
 def _solid_triangles(solid: object) -> np.ndarray:
@@ -83,11 +108,12 @@ def export_zone_mesh(graph: ZoneGraph, path: str | Path) -> Path:
     if graph.solids is None:
         raise ValueError("zone graph has no zone solids to mesh")
     BRepMesh_IncrementalMesh(make_compound(graph.solids), EXPORT_DEFLECTION, False, 0.5, False)
-    meshes = []
+    corners, colours = [], []
     for solid, inside in zip(graph.solids, graph.zone_inside, strict=True):
-        meshes.append(triangle_mesh(_solid_triangles(solid), INSIDE_RGBA if inside else OUTSIDE_RGBA))
-    mesh = trimesh.util.concatenate(meshes)
+        c = _solid_triangles(solid)
+        corners.append(c)
+        colours.append(np.tile(INSIDE_RGBA if inside else OUTSIDE_RGBA, (len(c), 1)))
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    mesh.export(path)
+    write_ply(path, np.concatenate(corners), np.concatenate(colours))
     return path

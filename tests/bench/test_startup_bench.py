@@ -1,0 +1,26 @@
+"""The start-up benchmark's measurement: a child's CPU, wall and peak memory come from its own
+``wait4`` record, so a process that allocates shows it and a failing one keeps its status."""
+
+from __future__ import annotations
+
+import sys
+
+from bench.startup_bench import measure, original_problem, table
+
+
+def test_measure_sees_the_childs_memory_and_cpu_and_exit_status(tmp_path):
+    big = measure(
+        [sys.executable, "-c", "b = bytearray(200 * 2**20); b[::4096] = b'x' * len(b[::4096])"], tmp_path
+    )
+    small = measure([sys.executable, "-c", "pass"], tmp_path)
+    assert big.rc == 0 and big.peak_mb > small.peak_mb + 150 and big.cpu_s > 0
+    assert measure([sys.executable, "-c", "raise SystemExit(3)"], tmp_path).rc == 3
+
+
+def test_the_original_is_skipped_with_a_reason_and_the_table_has_medians(tmp_path):
+    assert "no --original" in original_problem(None, sys.executable)
+    assert "not a brownvc/zone-graphs checkout" in original_problem(tmp_path, sys.executable)
+    run = {"rc": 0, "cpu_s": 1.0, "wall_s": 2.0, "peak_mb": 250.0}
+    rows = [{"part": p, "step_bytes": n, "build": run} for p, n in (("a", 10), ("b", 5))]
+    text = table(rows, ["build"], "because")
+    assert "| **median of 2** | 1.00 | 2.00 | 250 |" in text and "smallest part (b" in text
