@@ -35,7 +35,7 @@ import pandas as pd
 from eval.curves import curves, plot_curves, time_grid
 from eval.heldout import held_out, held_out_labelled, trained_projects
 from eval.programs import program_measures
-from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
+from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, ranked, ratios, summarise
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
 from eval.strips import pick_designs, write_strips
 from zonegraph.configs import Config, ConfigError, InferConfig, load_section
@@ -125,14 +125,27 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
     ranks = guide_ranks(labels, graphs, rankers, args.designs, designs)
     ranks.to_parquet(out / "ranks.parquet", index=False)
     table = summarise(ranks, seed=args.seed)
+    ratio = ratios(ranks, seed=args.seed)
     plot_ranks(table, out / "rank.png")
-    text = "## Relative GT rank\n\n" + markdown(table) + "\n![rank](rank.png)\n"
+    text = "## Relative GT rank\n\n" + markdown(table, ratio) + "\n![rank](rank.png)\n"
     folders = _folders(args)
     if folders:
         ranks["folder"] = ranks["design_id"].map(folders).fillna("")
-        per = ranks.groupby(["folder", "guide"], sort=True)["rank"].mean().unstack("guide")
-        text += "\nBy timeline folder (mean rank):\n\n" + _frame_md(per[table["guide"]]) + "\n"
-    return table, text
+        steps = ranked(ranks)
+        for metric, name in (("rank", "rank / P"), ("normalised", "normalised rank"), ("top1", "top-1")):
+            per = steps.groupby(["folder", "guide"], sort=True)[metric].mean().unstack("guide")
+            text += f"\nBy timeline folder (mean {name}):\n\n" + _frame_md(per[table["guide"]]) + "\n"
+    return table.assign(**_ratio_columns(table, ratio)), text
+
+
+def _ratio_columns(table: pd.DataFrame, ratio: pd.DataFrame) -> dict[str, list[float]]:
+    """The paired ratio to the heuristic per row of ``table`` (NaN for the heuristic itself)."""
+    by = {r.guide: r for r in ratio.itertuples()}
+    nan = float("nan")
+    return {
+        f"vs_heuristic{suffix}": [getattr(by[g], field) if g in by else nan for g in table["guide"]]
+        for suffix, field in (("", "ratio"), ("_ci_low", "ci_low"), ("_ci_high", "ci_high"))
+    }
 
 
 def _folders(args: argparse.Namespace) -> dict[str, str]:
@@ -272,16 +285,14 @@ def _marks_md(table: pd.DataFrame) -> str:
     return "\n".join([head, "|---|" + "---|" * len(marks), *rows]) + "\n"
 
 
+_KEYS = {"ci_low": "rank_ci_low", "ci_high": "rank_ci_high"}  # rank / P's interval, as before
+
+
 def metrics_of(rank: pd.DataFrame, curve_table: pd.DataFrame) -> dict[str, float]:
     metrics = {}
-    for r in rank.itertuples():
-        metrics.update(
-            {
-                f"rank.{r.guide}": r.rank,
-                f"rank_ci_low.{r.guide}": r.ci_low,
-                f"rank_ci_high.{r.guide}": r.ci_high,
-            }
-        )
+    names = [c for c in rank.columns if c not in ("guide", "designs")]
+    for r in rank.to_dict(orient="records"):
+        metrics.update({f"{_KEYS.get(n, n)}.{r['guide']}": float(r[n]) for n in names if pd.notna(r[n])})
     main = curve_table[curve_table["k"] == 5] if len(curve_table) else curve_table
     for guide, group in main.groupby("guide", sort=False):
         for mark in _marks(main):
