@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+import zonegraph.network
 from eval.curves import curves, plot_curves, time_grid
 from eval.heldout import held_out, held_out_labelled, trained_projects
 from eval.programs import program_measures
@@ -40,6 +41,7 @@ from eval.searches import Search, Target, folder_targets, run_searches, split_ta
 from eval.strips import pick_designs, write_strips
 from zonegraph.configs import Config, ConfigError, InferConfig, load_section
 
+SHIPPED = Path(zonegraph.network.__file__).resolve().parent / "checkpoints" / "scorer.pt"  # no torch import
 MARKS = (1.0, 5.0, 20.0)  # seconds at which IoU and exact rate are reported as metrics
 
 
@@ -95,8 +97,22 @@ class Guide:
 
 
 def guides_for(models: list[str]) -> list[Guide]:
-    """Random, heuristic and one network guide per model (``net`` alone, else ``net:<file>``)."""
-    nets = [Guide("net" if len(models) == 1 else f"net:{Path(m).stem}", "net", m) for m in models]
+    """Random, heuristic and one network guide per model: the shipped checkpoint is
+    ``net:shipped``, the first other one ``net`` (``make run``'s own), the rest ``net:<name>``
+    (the file's stem, or its folder's name for a ``scorer.pt``)."""
+    nets, names = [], set()
+    for m in models:
+        path = Path(m)
+        if path.resolve() == SHIPPED:
+            name = "net:shipped"
+        elif "net" not in names:
+            name = "net"
+        else:
+            name = f"net:{path.stem if path.stem != 'scorer' else path.parent.name}"
+        while name in names:
+            name += "'"
+        names.add(name)
+        nets.append(Guide(name, "net", m))
     return [Guide("random", "random"), Guide("heuristic", "heuristic"), *nets]
 
 
