@@ -2,10 +2,16 @@
 
 The paper's ranking metric (sec. 5.2): at every captured GT step of a test design, a guide scores
 all proposals of the state C_{i-1}; the GT's rank divided by the proposal count is averaged over
-steps (1/P is perfect, about 0.5 is random). The states come from the ``labels`` stage's Parquet
-shards (rank-only labels suffice: every proposal, the GT flagged), the zone graphs from the
-``zonegraphs`` stage, and every guide is reached through ``make_ranker``, so a network is scored
-exactly as the search would call it (``net`` with a checkpoint path).
+steps. That ratio's best value is 1/P and its random value (P + 1) / 2P, so it mixes the guide
+with the proposal counts; beside it every table carries the normalised rank (rank - 1) / (P - 1)
+(0: the GT first, 0.5: random, at any P), the oracle floor (mean 1/P, the best rank / P any guide
+could reach on these steps) and the top-1 / top-5 hit rates (``docs/evaluation.md``). Steps with
+a single proposal rank nothing: they are left out of every mean and counted (``single``).
+
+The states come from the ``labels`` stage's Parquet shards (rank-only labels suffice: every
+proposal, the GT flagged), the zone graphs from the ``zonegraphs`` stage, and every guide is
+reached through ``make_ranker``, so a network is scored exactly as the search would call it
+(``net`` with a checkpoint path).
 """
 
 from __future__ import annotations
@@ -20,7 +26,7 @@ import pandas as pd
 import pyarrow.dataset as ds
 
 from zonegraph.sequence.proposals import Op, Proposal
-from zonegraph.sequence.rankers import Ranker, make_ranker, relative_rank
+from zonegraph.sequence.rankers import GTPlace, Ranker, gt_place, make_ranker, score_step
 from zonegraph.zones.model import ZoneGraph
 from zonegraph.zones.storage import load_zone_graph
 
@@ -64,8 +70,10 @@ def rank_states(
     graphs_dir: str | Path,
     split: str | None = "test",
     designs: Sequence[str] | None = None,
+    singles: bool = False,
 ) -> Iterator[tuple[ZoneGraph, list[RankState]]]:
-    """Each design's zone graph with its rankable states (exactly one GT and another proposal)."""
+    """Each design's zone graph with its rankable states (exactly one GT and another proposal;
+    ``singles``: also the states whose GT is the only proposal)."""
     steps = _read(labels_dir, "steps", split, designs)
     proposals = _read(labels_dir, "proposals", split, designs)
     canvas_of: dict[tuple[Any, Any], Any] = {
@@ -76,7 +84,7 @@ def rank_states(
         states = []
         for step, group in rows.groupby("step", sort=True):
             is_gt = group["is_gt"].to_numpy(bool)
-            if is_gt.sum() != 1 or len(group) < 2:
+            if is_gt.sum() != 1 or len(group) < (1 if singles else 2):
                 continue
             states.append(
                 RankState(
@@ -97,6 +105,27 @@ def _proposal(row: Any, n_zones: int) -> Proposal:
     return Proposal(int(row.start_plane), int(row.end_plane), faces, _mask(row.zones, n_zones), op)
 
 
+METRICS = ("rank", "normalised", "floor", "top1", "top5")  # the per-step columns of guide_ranks
+COLUMNS = ["guide", "design_id", "step", "proposals", "above", "ties", *METRICS]
+
+
+def place_row(guide: str, state: RankState, place: GTPlace) -> dict[str, Any]:
+    """One ranked step: the GT's place and every scale of it (:data:`METRICS`)."""
+    return {
+        "guide": guide,
+        "design_id": state.design_id,
+        "step": state.step,
+        "proposals": place.proposals,
+        "above": place.above,
+        "ties": place.ties,
+        "rank": place.relative,
+        "normalised": place.normalised,
+        "floor": place.floor,
+        "top1": place.hit(1),
+        "top5": place.hit(5),
+    }
+
+
 def guide_ranks(
     labels_dir: str | Path,
     graphs_dir: str | Path,
@@ -104,22 +133,20 @@ def guide_ranks(
     split: str | None = "test",
     designs: Sequence[str] | None = None,
 ) -> pd.DataFrame:
-    """One row per (guide, design, step): the GT's relative rank and the proposal count."""
+    """One row per (guide, design, step): the GT's place on every scale (:data:`COLUMNS`).
+
+    A step whose GT is the only proposal gets a row (``proposals`` 1) without asking the guide:
+    :func:`summarise` counts it and leaves it out of the means."""
     rows = []
-    for graph, states in rank_states(labels_dir, graphs_dir, split, designs):
+    for graph, states in rank_states(labels_dir, graphs_dir, split, designs, singles=True):
         for name, ranker in guides.items():
             for state in states:
-                scores = np.asarray(ranker.score(graph, state.canvas, state.proposals), float)
-                rows.append(
-                    {
-                        "guide": name,
-                        "design_id": state.design_id,
-                        "step": state.step,
-                        "proposals": len(state.proposals),
-                        "rank": relative_rank(scores, state.is_gt),
-                    }
-                )
-    return pd.DataFrame(rows, columns=["guide", "design_id", "step", "proposals", "rank"])
+                if len(state.proposals) == 1:
+                    rows.append(place_row(name, state, GTPlace(0, 0, 1)))
+                    continue
+                scores = score_step(ranker, graph, state.canvas, state.proposals, state.step)
+                rows.append(place_row(name, state, gt_place(scores, state.is_gt)))
+    return pd.DataFrame(rows, columns=COLUMNS)
 
 
 def make_guides(names: Sequence[str], models: Sequence[str | Path] = (), seed: int = 0) -> dict[str, Ranker]:
@@ -132,66 +159,165 @@ def make_guides(names: Sequence[str], models: Sequence[str | Path] = (), seed: i
     return guides
 
 
-def bootstrap_mean(
-    ranks: pd.DataFrame, level: float = 0.9, samples: int = 2000, seed: int = 0
-) -> tuple[float, float, float]:
-    """Mean rank over steps and its ``level`` confidence interval, resampling whole designs.
+def _design_sums(ranks: pd.DataFrame, columns: Sequence[str]) -> tuple[list[str], np.ndarray]:
+    """Per design: the sums of ``columns`` and the step count, (D, len(columns) + 1)."""
+    grouped = ranks.groupby("design_id", sort=True)
+    sums = grouped[list(columns)].sum().join(grouped.size().rename("_count"))
+    return list(sums.index), sums.to_numpy(float)
+
+
+def _picks(designs: int, samples: int, seed: int) -> np.ndarray:
+    return np.random.default_rng(seed).integers(0, designs, size=(samples, designs))
+
+
+def _interval(values: np.ndarray, level: float) -> tuple[float, float]:
+    tail = (1 - level) / 2
+    low, high = np.quantile(values, [tail, 1 - tail])
+    return float(low), float(high)
+
+
+def bootstrap_means(
+    ranks: pd.DataFrame, columns: Sequence[str], level: float = 0.9, samples: int = 2000, seed: int = 0
+) -> dict[str, tuple[float, float, float]]:
+    """Per column: the mean over steps and its ``level`` interval, resampling whole designs (one
+    draw of designs for every column, so the intervals describe the same resamples).
 
     Designs, not steps, are the independent units: the steps of a design share one zone graph."""
-    per_design = ranks.groupby("design_id")["rank"].agg(["sum", "count"]).to_numpy()
-    mean = float(per_design[:, 0].sum() / per_design[:, 1].sum())
-    rng = np.random.default_rng(seed)
-    picks = rng.integers(0, len(per_design), size=(samples, len(per_design)))
-    sums = per_design[picks].sum(axis=1)  # (samples, 2)
-    means = sums[:, 0] / sums[:, 1]
-    tail = (1 - level) / 2
-    low, high = np.quantile(means, [tail, 1 - tail])
-    return mean, float(low), float(high)
+    _, sums = _design_sums(ranks, columns)
+    resampled = sums[_picks(len(sums), samples, seed)].sum(axis=1)  # (samples, C + 1)
+    out = {}
+    for i, column in enumerate(columns):
+        means = resampled[:, i] / resampled[:, -1]
+        out[column] = (float(sums[:, i].sum() / sums[:, -1].sum()), *_interval(means, level))
+    return out
+
+
+def bootstrap_mean(
+    ranks: pd.DataFrame, level: float = 0.9, samples: int = 2000, seed: int = 0, column: str = "rank"
+) -> tuple[float, float, float]:
+    """The mean of one column over steps with its interval (see :func:`bootstrap_means`)."""
+    return bootstrap_means(ranks, [column], level, samples, seed)[column]
+
+
+def ranked(ranks: pd.DataFrame) -> pd.DataFrame:
+    """The steps that rank something: more than one proposal (all, when counts are not known)."""
+    return ranks[ranks["proposals"] > 1] if "proposals" in ranks else ranks
 
 
 def summarise(ranks: pd.DataFrame, level: float = 0.9, seed: int = 0) -> pd.DataFrame:
-    """Per guide: designs, steps, mean relative rank with its bootstrap interval."""
+    """Per guide: designs, ranked steps, single-proposal steps left out, and every metric of
+    :data:`METRICS` with its bootstrap interval (``rank``, ``ci_low``, ``ci_high`` for rank / P;
+    ``<metric>``, ``<metric>_ci_low``, ``<metric>_ci_high`` for the others)."""
     rows = []
     for guide, group in ranks.groupby("guide", sort=False):
-        mean, low, high = bootstrap_mean(group, level, seed=seed)
-        rows.append(
-            {
-                "guide": guide,
-                "designs": group["design_id"].nunique(),
-                "steps": len(group),
-                "rank": mean,
-                "ci_low": low,
-                "ci_high": high,
-            }
-        )
+        steps = ranked(group)
+        row: dict[str, Any] = {
+            "guide": guide,
+            "designs": steps["design_id"].nunique(),
+            "steps": len(steps),
+            "single": int((group["proposals"] == 1).sum()) if "proposals" in group else 0,
+        }
+        if len(steps):
+            present = [m for m in METRICS if m in steps]
+            for metric, (mean, low, high) in bootstrap_means(steps, present, level, seed=seed).items():
+                prefix = "" if metric == "rank" else f"{metric}_"
+                row.update({metric: mean, f"{prefix}ci_low": low, f"{prefix}ci_high": high})
+        rows.append(row)
     return pd.DataFrame(rows)
 
 
-def markdown(table: pd.DataFrame) -> str:
-    """The summary as a Markdown table: rank with its interval per guide."""
-    lines = ["| guide | designs | steps | relative GT rank | 90% CI |", "|---|---|---|---|---|"]
-    lines += [
-        f"| {r.guide} | {r.designs} | {r.steps} | {r.rank:.4f} | {r.ci_low:.4f} - {r.ci_high:.4f} |"
-        for r in table.itertuples()
+def ratios(
+    ranks: pd.DataFrame,
+    base: str = "heuristic",
+    metric: str = "normalised",
+    level: float = 0.9,
+    samples: int = 2000,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """Per guide: its mean ``metric`` over the base guide's, with a paired bootstrap interval
+    (the same designs resampled for both; the issue's test: net <= 0.5 x heuristic)."""
+    steps = ranked(ranks)
+    if base not in set(steps["guide"]):
+        return pd.DataFrame(columns=["guide", "base", "ratio", "ci_low", "ci_high"])
+    _, base_sums = _design_sums(steps[steps["guide"] == base], [metric])
+    picks = _picks(len(base_sums), samples, seed)
+    base_means = base_sums[picks, 0].sum(axis=1) / base_sums[picks, 1].sum(axis=1)
+    rows = []
+    for guide, group in steps.groupby("guide", sort=False):
+        if guide == base:
+            continue
+        _, sums = _design_sums(group, [metric])
+        if len(sums) != len(base_sums):  # not the same designs: no pairing
+            continue
+        means = sums[picks, 0].sum(axis=1) / sums[picks, 1].sum(axis=1)
+        ratio = float((sums[:, 0].sum() / sums[:, 1].sum()) / (base_sums[:, 0].sum() / base_sums[:, 1].sum()))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            resampled = means / base_means
+        finite = resampled[np.isfinite(resampled)]  # a resample where the base ranks every GT first
+        low, high = _interval(finite, level) if len(finite) else (float("nan"), float("nan"))
+        rows.append({"guide": guide, "base": base, "ratio": ratio, "ci_low": low, "ci_high": high})
+    return pd.DataFrame(rows, columns=["guide", "base", "ratio", "ci_low", "ci_high"])
+
+
+LEGEND = (
+    "Means over steps with 90% bootstrap intervals over designs; rank / P is the paper's axis and the floor "
+    "its best value on these steps; the normalised rank (rank - 1) / (P - 1) is 0 for the GT first and 0.5 "
+    "for random (docs/evaluation.md).\n"
+)
+
+
+def markdown(table: pd.DataFrame, ratio: pd.DataFrame | None = None) -> str:
+    """The summary as a Markdown table: every metric with its interval per guide, then the
+    normalised rank of each guide over the heuristic's when ``ratio`` is given."""
+    lines = [
+        "| guide | designs | steps (single left out) | rank / P | floor | normalised rank | top-1 | top-5 |",
+        "|---|---|---|---|---|---|---|---|",
     ]
-    return "\n".join(lines) + "\n"
+    for r in table.to_dict(orient="records"):
+        if r["steps"] == 0:
+            lines.append(f"| {r['guide']} | 0 | 0 ({r['single']}) | | | | | |")
+            continue
+        cells = [f"{r['rank']:.4f} ({r['ci_low']:.4f} - {r['ci_high']:.4f})", f"{r['floor']:.4f}"]
+        cells += [f"{r[m]:.4f} ({r[m + '_ci_low']:.4f} - {r[m + '_ci_high']:.4f})" for m in ("normalised",)]
+        cells += [f"{r[m]:.3f} ({r[m + '_ci_low']:.3f} - {r[m + '_ci_high']:.3f})" for m in ("top1", "top5")]
+        head = f"| {r['guide']} | {r['designs']} | {r['steps']} ({r['single']}) | "
+        lines.append(head + " | ".join(cells) + " |")
+    text = "\n".join(lines) + "\n\n" + LEGEND
+    if ratio is not None and len(ratio):
+        base = ratio["base"].iloc[0]
+        text += f"\n| guide | normalised rank / {base}'s | 90% CI (paired) |\n|---|---|---|\n"
+        text += "".join(
+            f"| {r.guide} | {r.ratio:.3f} | {r.ci_low:.3f} - {r.ci_high:.3f} |\n" for r in ratio.itertuples()
+        )
+    return text
 
 
 def plot_ranks(table: pd.DataFrame, path: Path) -> Path:
-    """Bars of the mean relative rank per guide with their confidence intervals."""
+    """Bars per guide with their intervals: rank / P beside its floor, and the normalised rank
+    beside random's 0.5."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(1.2 * len(table) + 2, 3.2))
-    errors = [table["rank"] - table["ci_low"], table["ci_high"] - table["rank"]]
-    ax.bar(table["guide"], table["rank"], yerr=errors, capsize=4, color="C0")
-    for x, value in enumerate(table["rank"]):
-        ax.text(x, value / 2, f"{value:.3f}", ha="center", color="white")
-    ax.set(
-        ylabel="relative GT rank (lower is better)", ylim=(0, max(0.7, float(table["ci_high"].max()) + 0.05))
-    )
+    table = table[table["steps"] > 0]
+    fig, axes = plt.subplots(1, 2, figsize=(2.4 * len(table) + 3, 3.2))
+    for ax, (metric, low, high, label, line, line_label) in zip(
+        axes,
+        [
+            ("rank", "ci_low", "ci_high", "rank / P (the paper's axis)", "floor", "floor (GT always first)"),
+            ("normalised", "normalised_ci_low", "normalised_ci_high", "(rank - 1) / (P - 1)", None, "random"),
+        ],
+        strict=True,
+    ):
+        errors = [table[metric] - table[low], table[high] - table[metric]]
+        ax.bar(table["guide"], table[metric], yerr=errors, capsize=4, color="C0")
+        for x, value in enumerate(table[metric]):
+            ax.text(x, value / 2, f"{value:.3f}", ha="center", color="white")
+        level = float(table[line].mean()) if line else 0.5
+        ax.axhline(level, color="C3", linestyle="--", label=line_label)
+        ax.set(ylabel=f"{label}, lower is better", ylim=(0, max(0.7, float(table[high].max()) + 0.05)))
+        ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -220,12 +346,14 @@ def main() -> None:
         args.labels, args.graphs, make_guides(args.guides, args.model, args.seed), args.split, designs
     )
     table = summarise(ranks, seed=args.seed)
+    ratio = ratios(ranks, seed=args.seed)
     args.out.mkdir(parents=True, exist_ok=True)
     ranks.to_parquet(args.out / "ranks.parquet", index=False)
-    (args.out / "rank.json").write_text(json.dumps(table.to_dict(orient="records"), indent=2))
-    (args.out / "rank.md").write_text(markdown(table))
+    records = {"guides": table.to_dict(orient="records"), "vs_heuristic": ratio.to_dict(orient="records")}
+    (args.out / "rank.json").write_text(json.dumps(records, indent=2))
+    (args.out / "rank.md").write_text(markdown(table, ratio))
     plot_ranks(table, args.out / "rank.png")
-    print(table.to_string(index=False, float_format=lambda v: f"{v:.4f}"))
+    print(markdown(table, ratio))
 
 
 if __name__ == "__main__":

@@ -32,14 +32,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+import zonegraph.network
 from eval.curves import curves, plot_curves, time_grid
 from eval.heldout import held_out, held_out_labelled, trained_projects
 from eval.programs import program_measures
-from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
+from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, ranked, ratios, summarise
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
 from eval.strips import pick_designs, write_strips
 from zonegraph.configs import Config, ConfigError, InferConfig, load_section
 
+SHIPPED = Path(zonegraph.network.__file__).resolve().parent / "checkpoints" / "scorer.pt"  # no torch import
 MARKS = (1.0, 5.0, 20.0)  # seconds at which IoU and exact rate are reported as metrics
 
 
@@ -95,8 +97,22 @@ class Guide:
 
 
 def guides_for(models: list[str]) -> list[Guide]:
-    """Random, heuristic and one network guide per model (``net`` alone, else ``net:<file>``)."""
-    nets = [Guide("net" if len(models) == 1 else f"net:{Path(m).stem}", "net", m) for m in models]
+    """Random, heuristic and one network guide per model: the shipped checkpoint is
+    ``net:shipped``, the first other one ``net`` (``make run``'s own), the rest ``net:<name>``
+    (the file's stem, or its folder's name for a ``scorer.pt``)."""
+    nets, names = [], set()
+    for m in models:
+        path = Path(m)
+        if path.resolve() == SHIPPED:
+            name = "net:shipped"
+        elif "net" not in names:
+            name = "net"
+        else:
+            name = f"net:{path.stem if path.stem != 'scorer' else path.parent.name}"
+        while name in names:
+            name += "'"
+        names.add(name)
+        nets.append(Guide(name, "net", m))
     return [Guide("random", "random"), Guide("heuristic", "heuristic"), *nets]
 
 
@@ -125,14 +141,27 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
     ranks = guide_ranks(labels, graphs, rankers, args.designs, designs)
     ranks.to_parquet(out / "ranks.parquet", index=False)
     table = summarise(ranks, seed=args.seed)
+    ratio = ratios(ranks, seed=args.seed)
     plot_ranks(table, out / "rank.png")
-    text = "## Relative GT rank\n\n" + markdown(table) + "\n![rank](rank.png)\n"
+    text = "## Relative GT rank\n\n" + markdown(table, ratio) + "\n![rank](rank.png)\n"
     folders = _folders(args)
     if folders:
         ranks["folder"] = ranks["design_id"].map(folders).fillna("")
-        per = ranks.groupby(["folder", "guide"], sort=True)["rank"].mean().unstack("guide")
-        text += "\nBy timeline folder (mean rank):\n\n" + _frame_md(per[table["guide"]]) + "\n"
-    return table, text
+        steps = ranked(ranks)
+        for metric, name in (("rank", "rank / P"), ("normalised", "normalised rank"), ("top1", "top-1")):
+            per = steps.groupby(["folder", "guide"], sort=True)[metric].mean().unstack("guide")
+            text += f"\nBy timeline folder (mean {name}):\n\n" + _frame_md(per[table["guide"]]) + "\n"
+    return table.assign(**_ratio_columns(table, ratio)), text
+
+
+def _ratio_columns(table: pd.DataFrame, ratio: pd.DataFrame) -> dict[str, list[float]]:
+    """The paired ratio to the heuristic per row of ``table`` (NaN for the heuristic itself)."""
+    by = {r.guide: r for r in ratio.itertuples()}
+    nan = float("nan")
+    return {
+        f"vs_heuristic{suffix}": [getattr(by[g], field) if g in by else nan for g in table["guide"]]
+        for suffix, field in (("", "ratio"), ("_ci_low", "ci_low"), ("_ci_high", "ci_high"))
+    }
 
 
 def _folders(args: argparse.Namespace) -> dict[str, str]:
@@ -272,16 +301,14 @@ def _marks_md(table: pd.DataFrame) -> str:
     return "\n".join([head, "|---|" + "---|" * len(marks), *rows]) + "\n"
 
 
+_KEYS = {"ci_low": "rank_ci_low", "ci_high": "rank_ci_high"}  # rank / P's interval, as before
+
+
 def metrics_of(rank: pd.DataFrame, curve_table: pd.DataFrame) -> dict[str, float]:
     metrics = {}
-    for r in rank.itertuples():
-        metrics.update(
-            {
-                f"rank.{r.guide}": r.rank,
-                f"rank_ci_low.{r.guide}": r.ci_low,
-                f"rank_ci_high.{r.guide}": r.ci_high,
-            }
-        )
+    names = [c for c in rank.columns if c not in ("guide", "designs")]
+    for r in rank.to_dict(orient="records"):
+        metrics.update({f"{_KEYS.get(n, n)}.{r['guide']}": float(r[n]) for n in names if pd.notna(r[n])})
     main = curve_table[curve_table["k"] == 5] if len(curve_table) else curve_table
     for guide, group in main.groupby("guide", sort=False):
         for mark in _marks(main):

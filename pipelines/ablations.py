@@ -4,7 +4,8 @@
                                   [--epochs 3] [--eval-designs 100] [--out data/eval/ablations]
 
 Each variant is one training run of ``training.train`` with the ``train`` section of the params
-and an override (``rounds`` = r, or ``use_points`` = false at the section's rounds), tracked in
+and an override (``rounds`` = r, or ``use_points`` = false at the section's rounds; the other
+loss, the proposal features switched, and both), tracked in
 the MLflow experiment ``ablations``. Each is then scored by relative GT rank on the same test
 designs, none of a project any variant trained on (``eval.heldout``). Variants train on a seeded
 sample of ``--designs`` training designs: the ablation compares variants at equal data, and on
@@ -20,8 +21,9 @@ from dataclasses import asdict, replace
 from pathlib import Path
 
 from eval.heldout import held_out_labelled, trained_projects
-from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, summarise
+from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, ratios, summarise
 from training.train import TrainConfig, train
+from zonegraph.sequence.features import FEATURES
 
 from .params import section
 
@@ -31,6 +33,19 @@ def variants(base: TrainConfig, rounds: list[int]) -> dict[str, TrainConfig]:
     out = {f"rounds{r}": replace(base, rounds=r, use_points=True) for r in rounds}
     out[f"rounds{base.rounds}_no_points"] = replace(base, use_points=False)
     return out
+
+
+def objective_variants(base: TrainConfig) -> dict[str, TrainConfig]:
+    """The learned guide's own ablations (issue 24): the other objective, and the proposal
+    features switched off (or on, when the base has none), each alone and both together."""
+    other = "listwise" if base.loss == "focal" else "focal"
+    features = () if base.features else FEATURES
+    flip = "no_features" if base.features else "features"
+    return {
+        f"loss_{other}": replace(base, loss=other, neutral_credit=None),
+        flip: replace(base, features=features),
+        f"loss_{other}_{flip}": replace(base, loss=other, neutral_credit=None, features=features),
+    }
 
 
 def train_variant(name: str, config: TrainConfig, out: Path) -> Path:
@@ -65,7 +80,8 @@ def main() -> None:
         experiment="ablations",
     )
     args.out.mkdir(parents=True, exist_ok=True)
-    models = [train_variant(name, config, args.out) for name, config in variants(base, args.rounds).items()]
+    chosen = {**variants(base, args.rounds), **objective_variants(base)}
+    models = [train_variant(name, config, args.out) for name, config in chosen.items()]
     designs = held_out_labelled(base.labels_dir, "test", trained_projects(models)[0])[: args.eval_designs]
     guides = make_guides(["random", "heuristic"], models, base.seed)
     ranks = guide_ranks(base.labels_dir, base.graphs_dir, guides, "test", designs)
@@ -76,7 +92,8 @@ def main() -> None:
         f"## Ablations: relative GT rank on {ranks['design_id'].nunique()} held-out test designs\n\n"
         f"(the first {len(designs)} by id; the others have no step with a captured GT and another proposal)\n"
         f"Each network trained on {args.designs} designs for {args.epochs} epochs "
-        f"({base.fusion} fusion, {base.points_per_zone} points per zone).\n\n" + markdown(table)
+        f"({base.fusion} fusion, {base.points_per_zone} points per zone).\n\n"
+        + markdown(table, ratios(ranks, seed=base.seed))
     )
     (args.out / "ablations.md").write_text(text + "\n![ablations](ablations.png)\n")
     (args.out / "ablations.json").write_text(table.to_json(orient="records", indent=2))

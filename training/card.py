@@ -57,8 +57,15 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
         "## Metrics",
         "",
         f"- best epoch {metrics['epoch']}: validation relative GT rank **{metrics['val_rank']:.4f}** "
-        f"over {metrics.get('val_steps', '?')} steps, validation focal loss {metrics['val_loss']:.4f}",
+        f"over {metrics.get('val_steps', '?')} steps, validation {train.get('loss', 'focal')} loss "
+        f"{metrics['val_loss']:.4f}",
     ]
+    if "val_normalised" in metrics:  # checkpoints trained before the other scales have rank / P only
+        lines.append(
+            f"- validation normalised GT rank (rank - 1) / (P - 1) **{metrics['val_normalised']:.4f}** "
+            f"(0.5 random), rank / P floor {metrics['val_floor']:.4f}, top-1 {metrics['val_top1']:.3f}, "
+            f"top-5 {metrics['val_top5']:.3f} (docs/evaluation.md)"
+        )
     if test_ranks:
         lines.append(
             "- test split relative GT rank: "

@@ -2,8 +2,10 @@
 
 One example is one GT step of one design (a *state*): its canvas and a set of proposals with their
 labels, encoded as the search encodes a state (:mod:`zonegraph.network.encoding`) with the labels
-added. Geometry is read from each saved graph once, when the dataset is built, keeping
-``points_per_zone`` of its surface samples (seeded).
+added, and the proposal features the labels stage stored (``feat_<name>`` columns; zeros for
+shards written before them, which :attr:`LabelDataset.has_features` tells). Geometry is read from
+each saved graph once, when the dataset is built, keeping ``points_per_zone`` of its surface
+samples (seeded).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import torch
 from torch_geometric.data import Dataset
 
 from zonegraph.network.encoding import Geometry, StateData, geometry_of, state_data
+from zonegraph.sequence.features import FEATURES
 from zonegraph.zones.storage import load_zone_graph
 
 
@@ -36,13 +39,15 @@ class _State:
     ops: np.ndarray  # (P,)
     labels: np.ndarray  # (P,) 1, 0, -1
     is_gt: np.ndarray  # (P,)
+    features: np.ndarray  # (P, F) float32, zonegraph.sequence.features.FEATURES
 
 
 class LabelDataset(Dataset):
     """States from the label shards of ``labels_dir`` whose designs are in ``design_ids``.
 
-    ``mode="train"`` keeps positives and negatives only (the focal loss ignores neutrals) and at
-    most ``max_proposals`` of a state's proposals (the positive always, negatives seeded);
+    ``mode="train"`` keeps positives and negatives only (the focal loss ignores neutrals; with
+    ``neutrals`` the neutrals too, for a listwise loss that gives them partial credit) and at most
+    ``max_proposals`` of a state's proposals (the positive always, the others seeded);
     ``mode="rank"`` keeps every proposal, to rank the GT among all of them.
     """
 
@@ -55,10 +60,12 @@ class LabelDataset(Dataset):
         max_proposals: int = 64,
         points_per_zone: int | None = 128,
         seed: int = 0,
+        neutrals: bool = False,
     ):
         super().__init__()
-        self.mode, self.max_proposals, self.seed = mode, max_proposals, seed
+        self.mode, self.max_proposals, self.seed, self.neutrals = mode, max_proposals, seed, neutrals
         table = ds.dataset(Path(labels_dir) / "proposals", format="parquet").to_table()
+        self.has_features = all(f"feat_{name}" in table.column_names for name in FEATURES)
         steps = ds.dataset(Path(labels_dir) / "steps", format="parquet").to_table()
         if design_ids is not None:
             wanted = set(design_ids)
@@ -84,9 +91,15 @@ class LabelDataset(Dataset):
                     np.where(rows["operation"].to_numpy() == "union", 1, -1),
                     rows["label"].to_numpy().astype(np.int64),
                     rows["is_gt"].to_numpy().astype(bool),
+                    self._features(rows),
                 )
             )
         return out
+
+    def _features(self, rows) -> np.ndarray:
+        if not self.has_features:
+            return np.zeros((len(rows), len(FEATURES)), np.float32)
+        return rows[[f"feat_{name}" for name in FEATURES]].to_numpy(np.float32, copy=True)
 
     def len(self) -> int:
         return len(self.states)
@@ -95,7 +108,7 @@ class LabelDataset(Dataset):
         if self.mode == "rank":
             return np.arange(len(state.labels))
         pos = np.flatnonzero(state.labels == 1)
-        neg = np.flatnonzero(state.labels == -1)
+        neg = np.flatnonzero(state.labels == -1 if not self.neutrals else state.labels != 1)
         if len(neg) > self.max_proposals - len(pos):
             rng = np.random.default_rng([self.seed, idx])
             neg = np.sort(rng.choice(neg, self.max_proposals - len(pos), replace=False))
@@ -109,6 +122,7 @@ class LabelDataset(Dataset):
             torch.from_numpy(state.canvas),
             torch.from_numpy(state.zones[keep]),
             torch.from_numpy(state.ops[keep]),
+            torch.from_numpy(state.features[keep]),
             y=torch.from_numpy((state.labels[keep] == 1).astype(np.int64)),
             label=torch.from_numpy(state.labels[keep]),
             is_gt=torch.from_numpy(state.is_gt[keep]),

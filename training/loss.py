@@ -1,9 +1,20 @@
-"""Focal loss (Lin et al. 2017) on two-class logits, as the paper trains the scorer."""
+"""The scorer's objectives: focal loss per proposal (the paper's), or a listwise softmax per state.
+
+Both read the same two logits per proposal, and the network guide ranks by P(positive) =
+softmax(logits)[1], which is monotonic in the log-odds ``logits[1] - logits[0]``; the listwise
+loss is a softmax of those log-odds over each state's proposals, so either objective trains the
+one score the search sorts by. The focal loss judges each proposal alone, while the metric the
+guide is judged by (where the GT lands among a state's proposals) is a property of the whole
+list; the listwise loss trains that directly.
+"""
 
 from __future__ import annotations
 
 import torch
 from torch import Tensor
+from torch_geometric.utils import scatter
+
+LOSSES = ("focal", "listwise")
 
 
 def focal_loss(logits: Tensor, target: Tensor, gamma: float = 0.5) -> Tensor:
@@ -19,3 +30,25 @@ def focal_loss(logits: Tensor, target: Tensor, gamma: float = 0.5) -> Tensor:
     # (p rounds to 1 in float32) turned every gradient into NaN. Below 1e-12 the factor is flat.
     modulating = (-torch.expm1(log_p)).clamp_min(1e-12) ** gamma
     return (-modulating * log_p).mean()
+
+
+def listwise_loss(logits: Tensor, state: Tensor, weight: Tensor) -> Tensor:
+    """Cross-entropy between each state's softmax over its proposals and a target distribution.
+
+    The target of a state is ``weight`` normalised over its proposals: the GT alone (weight 1,
+    the others 0) is ListNet's top-one loss with the GT as the answer; neutral proposals given a
+    partial weight share the target with it. States whose weights sum to 0 are left out.
+
+    Shapes:
+        logits: (P, 2); state: (P,) int64, the state of each proposal (0..S-1); weight: (P,) >= 0.
+    """
+    score = logits[:, 1] - logits[:, 0]
+    states = int(state.max()) + 1 if len(state) else 0
+    top = scatter(score.detach(), state, dim=0, dim_size=states, reduce="max")
+    log_z = scatter((score - top[state]).exp(), state, dim=0, dim_size=states, reduce="sum").log() + top
+    log_p = score - log_z[state]
+    total = scatter(weight, state, dim=0, dim_size=states, reduce="sum")
+    target = weight / total[state].clamp_min(1e-12)
+    per_state = -scatter(target * log_p, state, dim=0, dim_size=states, reduce="sum")
+    used = total > 0
+    return per_state[used].mean() if bool(used.any()) else score.sum() * 0.0

@@ -1,16 +1,24 @@
 """Train the proposal scorer on the ``labels`` stage's shards, tracked in MLflow.
 
-    python -m training.train [--params params.yaml] [--device cpu|cuda]
+    python -m training.train [--params params.yaml] [--device cpu|cuda|auto] [--fresh]
 
 Designs of the labelled training split are split again by project into training and validation
-(``train.val_fraction``). Every epoch logs the training and validation focal loss and the
-validation relative GT rank (the rank of the GT among all of a step's proposals over their count,
-averaged; lower is better). The checkpoint with the best validation rank is written to
-``models/scorer.pt`` with ``models/metrics.json``; ``models/curve.csv`` and ``models/curve.png``
-hold the learning curves. The run logs its parameters, metrics, the data version (a hash of the
-label shards), the git commit and the checkpoint to MLflow: ``MLFLOW_TRACKING_URI`` when set,
-else ``sqlite:///mlflow.db`` in the working directory (``mlflow ui --backend-store-uri
-sqlite:///mlflow.db`` shows it).
+(``train.val_fraction``). The objective is ``train.loss``: the paper's focal loss per proposal or
+a listwise softmax over each state's proposals with the GT as target (``train.neutral_credit``
+gives neutral proposals partial credit); ``train.features`` names the proposal features the
+scorer reads beside the zones (:mod:`zonegraph.sequence.features`). Every epoch logs the
+training and validation loss and the validation GT rank on every scale (rank / P, its floor,
+the normalised rank, top-1 and top-5; ``docs/evaluation.md``). The checkpoint with the best
+validation normalised rank is written to ``models/scorer.pt`` with ``models/metrics.json``;
+``models/curve.csv`` and ``models/curve.png`` hold the learning curves.
+
+A run resumes: every epoch also writes ``models/last.pt`` (weights, optimiser, the shuffle's
+random state, the curve so far, the MLflow run), and a run started with the same settings and
+labels (the epoch count and device aside, so raising ``epochs`` continues a finished run) goes on
+from its last epoch in the same MLflow run; ``--fresh`` starts over. The run logs its
+parameters, metrics, the data version (a hash of the label shards), the git commit and the
+checkpoint to MLflow: ``MLFLOW_TRACKING_URI`` when set, else ``sqlite:///mlflow.db`` in the
+working directory (``mlflow ui --backend-store-uri sqlite:///mlflow.db`` shows it).
 """
 
 from __future__ import annotations
@@ -32,22 +40,25 @@ import torch
 from torch_geometric.loader import DataLoader
 
 from training.data import LabelDataset
-from training.loss import focal_loss
+from training.loss import LOSSES, focal_loss, listwise_loss
 from zonegraph.configs import Config, ConfigError, load_section
 from zonegraph.data.dataset import project_of, test_ids
 from zonegraph.network.model import ModelConfig, ProposalScorer
 from zonegraph.network.scoring import score_state
-from zonegraph.sequence.rankers import relative_rank
+from zonegraph.sequence.rankers import GTPlace, gt_place
 
 DEFAULT_TRACKING = "sqlite:///mlflow.db"
+LAST = "last.pt"  # the resumable state, beside the best checkpoint
+SELECT = "val_normalised"  # the validation metric that picks the best epoch (lower is better)
 
 
 @dataclass(frozen=True)
 class TrainConfig(Config):
     """Everything a run depends on (``params.yaml: train``).
 
-    The defaults are what ``make run`` trains (``params.yaml`` repeats them, so that DVC tracks
-    each); the shipped checkpoint's own settings are in ``training/checkpoints/MODEL_CARD.md``.
+    The defaults are the paper's network and objective; ``params.yaml`` sets what ``make run``
+    trains (DVC tracks each key there); the shipped checkpoint's own settings are in
+    ``zonegraph/network/checkpoints/MODEL_CARD.md``.
     """
 
     labels_dir: str = "data/labels"
@@ -56,6 +67,9 @@ class TrainConfig(Config):
     fusion: str = "late"
     rounds: int = 3
     use_points: bool = True
+    features: tuple[str, ...] = ()  # proposal features the scorer reads (zonegraph.sequence.features)
+    loss: str = "focal"  # focal (per proposal) or listwise (softmax over a state's proposals)
+    neutral_credit: float | None = None  # listwise: None leaves neutrals out, else their target weight
     epochs: int = 3
     lr: float = 1e-3
     batch_states: int = 8  # states per batch (each with up to max_proposals proposals)
@@ -65,12 +79,27 @@ class TrainConfig(Config):
     val_fraction: float = 0.15
     max_designs: int | None = None  # a seeded sample of the training designs (quick runs, costly fusions)
     seed: int = 0
-    device: str = "auto"
+    device: str = "cpu"  # cpu, cuda, or auto (cuda when available)
     experiment: str = "zonegraph-scorer"
 
     @property
     def model(self) -> ModelConfig:
-        return ModelConfig(fusion=self.fusion, rounds=self.rounds, use_points=self.use_points)
+        return ModelConfig(
+            fusion=self.fusion, rounds=self.rounds, use_points=self.use_points, features=self.features
+        )
+
+    def check(self) -> None:
+        """One line naming what is wrong with the settings (SystemExit), before any data is read."""
+        if self.loss not in LOSSES:
+            raise SystemExit(f"train: unknown loss {self.loss!r} (one of {', '.join(LOSSES)})")
+        if self.neutral_credit is not None and (self.loss != "listwise" or self.neutral_credit < 0):
+            raise SystemExit("train: neutral_credit is a non-negative weight of the listwise loss")
+        try:
+            self.model.feature_columns()
+        except ValueError as exc:
+            raise SystemExit(f"train: {exc}") from None
+        if self.device == "cuda" and not torch.cuda.is_available():
+            raise SystemExit("train: --device cuda, but torch finds no CUDA device (use cpu or auto)")
 
 
 def pick_device(name: str) -> torch.device:
@@ -84,21 +113,32 @@ def forward(model: ProposalScorer, batch: Any) -> torch.Tensor:
     return model(batch)
 
 
-def mean_loss(model: ProposalScorer, loader: DataLoader, device: torch.device, gamma: float) -> float:
+def objective(config: TrainConfig, logits: torch.Tensor, batch: Any) -> torch.Tensor:
+    """The configured loss of one batch."""
+    if config.loss == "focal":
+        keep = batch.label != 0  # neutrals kept for a listwise loss carry no focal signal
+        return focal_loss(logits[keep], batch.y[keep], config.gamma)
+    weight = (batch.label == 1).float()
+    if config.neutral_credit:
+        weight = weight + config.neutral_credit * (batch.label == 0).float()
+    return listwise_loss(logits, batch.state, weight)
+
+
+def mean_loss(model: ProposalScorer, loader: DataLoader, device: torch.device, config: TrainConfig) -> float:
     model.eval()
     total, count = 0.0, 0
     with torch.no_grad():
         for batch in loader:
             batch = batch.to(device)
             logits = forward(model, batch)
-            total += float(focal_loss(logits, batch.y, gamma)) * len(batch.y)
+            total += float(objective(config, logits, batch)) * len(batch.y)
             count += len(batch.y)
     return total / max(count, 1)
 
 
-def rank_scores(model: ProposalScorer, dataset: LabelDataset, device: torch.device) -> list[float]:
-    """Relative GT rank of every state of a rank-mode dataset (states with a GT and others)."""
-    ranks = []
+def rank_places(model: ProposalScorer, dataset: LabelDataset, device: torch.device) -> list[GTPlace]:
+    """The GT's place in every state of a rank-mode dataset (states with a GT and others)."""
+    places = []
     for state in dataset.states:
         if int(state.is_gt.sum()) != 1 or len(state.is_gt) < 2:
             continue
@@ -109,9 +149,23 @@ def rank_scores(model: ProposalScorer, dataset: LabelDataset, device: torch.devi
             torch.from_numpy(state.zones),
             torch.from_numpy(state.ops),
             device,
+            features=torch.from_numpy(state.features),
         )
-        ranks.append(relative_rank(scores, state.is_gt))
-    return ranks
+        places.append(gt_place(scores, state.is_gt))
+    return places
+
+
+def rank_metrics(places: list[GTPlace], prefix: str = "val_") -> dict[str, float]:
+    """Means over steps of every scale of the GT's rank (``docs/evaluation.md``)."""
+    if not places:
+        return {f"{prefix}{k}": float("nan") for k in ("rank", "normalised", "floor", "top1", "top5")}
+    return {
+        f"{prefix}rank": float(np.mean([p.relative for p in places])),
+        f"{prefix}normalised": float(np.mean([p.normalised for p in places])),
+        f"{prefix}floor": float(np.mean([p.floor for p in places])),
+        f"{prefix}top1": float(np.mean([p.hit(1) for p in places])),
+        f"{prefix}top5": float(np.mean([p.hit(5) for p in places])),
+    }
 
 
 def data_version(labels_dir: str | Path) -> str:
@@ -144,10 +198,46 @@ def split_designs(labels_dir: str | Path, seed: int, fraction: float) -> tuple[l
     return [i for i in ids if i not in val], sorted(val)
 
 
-def train(config: TrainConfig) -> dict[str, Any]:
-    """One training run; returns the best epoch's metrics (also in ``out_dir/metrics.json``)."""
+def resume_key(config: TrainConfig, version: str) -> dict[str, Any]:
+    """What a resumed run must share with the one it continues: every setting but the epoch
+    count and the device, and the labels."""
+    settings = {k: v for k, v in asdict(config).items() if k not in ("epochs", "device")}
+    return {**settings, "features": list(config.features), "data_version": version}
+
+
+def load_last(path: Path, key: dict[str, Any], epochs: int) -> dict[str, Any] | None:
+    """The resumable state at ``path`` when it continues a run of these settings, else None."""
+    if not path.is_file():
+        return None
+    last: dict[str, Any] = torch.load(path, map_location="cpu", weights_only=True)
+    if last.get("key") != key or last["epoch"] >= epochs:
+        return None
+    return last
+
+
+def datasets(config: TrainConfig, train_ids: list[str], val_ids: list[str]) -> dict[str, LabelDataset]:
+    common = dict(points_per_zone=config.points_per_zone, seed=config.seed)
+    neutrals = config.loss == "listwise" and config.neutral_credit is not None
+    args = (config.labels_dir, config.graphs_dir)
+    sets = {
+        "train": LabelDataset(*args, train_ids, "train", config.max_proposals, neutrals=neutrals, **common),
+        "val": LabelDataset(*args, val_ids, "train", config.max_proposals, neutrals=neutrals, **common),
+        "rank": LabelDataset(*args, val_ids, "rank", **common),
+    }
+    if config.features and not sets["train"].has_features:
+        raise SystemExit(
+            f"train: {config.labels_dir}: the label shards have no proposal features "
+            "(written before them): relabel, or train with features: []"
+        )
+    return sets
+
+
+def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
+    """One training run, or the rest of an interrupted one; returns the best epoch's metrics
+    (also in ``out_dir/metrics.json``)."""
     import mlflow  # a heavy import: only when training
 
+    config.check()
     torch.manual_seed(config.seed)
     np.random.seed(config.seed)
     device = pick_device(config.device)
@@ -155,16 +245,7 @@ def train(config: TrainConfig) -> dict[str, Any]:
     if config.max_designs is not None and config.max_designs < len(train_ids):
         keep = np.random.default_rng(config.seed).choice(len(train_ids), config.max_designs, replace=False)
         train_ids = [train_ids[i] for i in sorted(keep)]
-    common = dict(points_per_zone=config.points_per_zone, seed=config.seed)
-    sets = {
-        "train": LabelDataset(
-            config.labels_dir, config.graphs_dir, train_ids, "train", config.max_proposals, **common
-        ),
-        "val": LabelDataset(
-            config.labels_dir, config.graphs_dir, val_ids, "train", config.max_proposals, **common
-        ),
-        "rank": LabelDataset(config.labels_dir, config.graphs_dir, val_ids, "rank", **common),
-    }
+    sets = datasets(config, train_ids, val_ids)
     generator = torch.Generator().manual_seed(config.seed)
     train_loader = DataLoader(
         sets["train"], batch_size=config.batch_states, shuffle=True, generator=generator
@@ -174,21 +255,37 @@ def train(config: TrainConfig) -> dict[str, Any]:
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
     out = Path(config.out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    version = data_version(config.labels_dir)
+    key = resume_key(config, version)
+    last = None if fresh else load_last(out / LAST, key, config.epochs)
+    curve: list[dict[str, Any]] = []
+    best: dict[str, Any] = {SELECT: float("inf")}
+    first = 1
+    if last is not None:
+        model.load_state_dict(last["model"])
+        optimiser.load_state_dict(last["optimiser"])
+        generator.set_state(last["generator"])
+        torch.set_rng_state(last["torch_rng"])
+        curve, best, first = last["curve"], last["best"], last["epoch"] + 1
+        print(f"train: resuming at epoch {first} of {config.epochs}, MLflow run {last['run_id']}", flush=True)
     mlflow.set_tracking_uri(os.environ.get("MLFLOW_TRACKING_URI", DEFAULT_TRACKING))
     mlflow.set_experiment(config.experiment)
-    curve, best = [], {"val_rank": float("inf")}
-    with mlflow.start_run() as run:
+    with mlflow.start_run(run_id=last["run_id"] if last else None) as run:
         sizes = {
             "train_designs": len(train_ids),
             "val_designs": len(val_ids),
             "train_states": len(sets["train"]),
         }
-        mlflow.log_params({**asdict(config), **sizes, "device": str(device)})
-        tags = {"data_version": data_version(config.labels_dir), "git_commit": git_commit()}
-        mlflow.set_tags(tags)
+        tags = {"data_version": version, "git_commit": git_commit()}
+        if last is None:
+            mlflow.log_params({**asdict(config), **sizes, "device": str(device)})
+            mlflow.set_tags(tags)
+        else:
+            resumed = {f"resumed_at_epoch_{first}": str(device), "git_commit_resumed": tags["git_commit"]}
+            mlflow.set_tags(resumed)
         seen = sorted({project_of(d) for d in [*train_ids, *val_ids]})  # evaluation must skip these
         provenance = {**sizes, **tags, "run_id": run.info.run_id, "train_projects": seen}
-        for epoch in range(1, config.epochs + 1):
+        for epoch in range(first, config.epochs + 1):
             t0 = time.perf_counter()
             model.train()
             losses = []
@@ -196,17 +293,17 @@ def train(config: TrainConfig) -> dict[str, Any]:
                 batch = batch.to(device)
                 if len(batch.y) < 2:  # BatchNorm needs two examples
                     continue
-                loss = focal_loss(forward(model, batch), batch.y, config.gamma)
+                loss = objective(config, forward(model, batch), batch)
                 optimiser.zero_grad()
                 loss.backward()
                 optimiser.step()
                 losses.append(loss.item())
-            ranks = rank_scores(model, sets["rank"], device)
+            places = rank_places(model, sets["rank"], device)
             row = {
                 "epoch": epoch,
                 "train_loss": float(np.mean(losses)) if losses else float("nan"),
-                "val_loss": mean_loss(model, val_loader, device, config.gamma),
-                "val_rank": float(np.mean(ranks)) if ranks else float("nan"),
+                "val_loss": mean_loss(model, val_loader, device, config),
+                **rank_metrics(places),
                 "seconds": time.perf_counter() - t0,
             }
             if not np.isfinite(row["train_loss"]):
@@ -218,9 +315,10 @@ def train(config: TrainConfig) -> dict[str, Any]:
                 f"epoch {epoch}: " + ", ".join(f"{k} {v:.4f}" for k, v in row.items() if k != "epoch"),
                 flush=True,
             )
-            if row["val_rank"] <= best["val_rank"] or not np.isfinite(best["val_rank"]):
-                best = {**row, "val_steps": len(ranks)}
+            if row[SELECT] <= best[SELECT] or not np.isfinite(best[SELECT]):
+                best = {**row, "val_steps": len(places)}
                 save_checkpoint(model, config, best, out / "scorer.pt", provenance)
+            save_last(out / LAST, model, optimiser, generator, key, epoch, curve, best, run.info.run_id)
         if not curve:
             raise SystemExit("train: no epoch finished with a finite loss; no checkpoint written")
         write_curves(curve, out)
@@ -229,6 +327,34 @@ def train(config: TrainConfig) -> dict[str, Any]:
         mlflow.log_artifact(str(out / "scorer.pt"))
         mlflow.log_artifact(str(out / "curve.png"))
     return best
+
+
+def save_last(
+    path: Path,
+    model: ProposalScorer,
+    optimiser: torch.optim.Optimizer,
+    generator: torch.Generator,
+    key: dict[str, Any],
+    epoch: int,
+    curve: list[dict[str, Any]],
+    best: dict[str, Any],
+    run_id: str,
+) -> None:
+    """Everything the next epoch needs, written atomically (a kill mid-write keeps the last one)."""
+    state = {
+        "key": key,
+        "epoch": epoch,
+        "model": model.state_dict(),
+        "optimiser": optimiser.state_dict(),
+        "generator": generator.get_state(),
+        "torch_rng": torch.get_rng_state(),
+        "curve": curve,
+        "best": best,
+        "run_id": run_id,
+    }
+    tmp = path.with_suffix(".tmp")
+    torch.save(state, tmp)
+    tmp.replace(path)
 
 
 def save_checkpoint(
@@ -262,10 +388,14 @@ def write_curves(curve: list[dict], out: Path) -> None:
     fig, (a, b) = plt.subplots(1, 2, figsize=(9, 3.5))
     a.plot(epochs, [r["train_loss"] for r in curve], label="train")
     a.plot(epochs, [r["val_loss"] for r in curve], label="validation")
-    a.set(xlabel="epoch", ylabel="focal loss")
+    a.set(xlabel="epoch", ylabel="loss")
     a.legend()
-    b.plot(epochs, [r["val_rank"] for r in curve], color="C2")
-    b.set(xlabel="epoch", ylabel="validation relative GT rank")
+    b.plot(epochs, [r["val_rank"] for r in curve], color="C2", label="rank / P")
+    b.plot(epochs, [r["val_floor"] for r in curve], color="C2", linestyle=":", label="floor of rank / P")
+    b.plot(epochs, [r["val_normalised"] for r in curve], color="C1", label="normalised rank")
+    b.axhline(0.5, color="C3", linestyle="--", label="random (normalised)")
+    b.set(xlabel="epoch", ylabel="validation GT rank")
+    b.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out / "curve.png", dpi=110)
     plt.close(fig)
@@ -274,7 +404,13 @@ def write_curves(curve: list[dict], out: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--params", default="params.yaml")
-    parser.add_argument("--device", default=None, help="cpu, cuda or auto (default: params)")
+    parser.add_argument(
+        "--device",
+        default=None,
+        choices=["cpu", "cuda", "auto"],
+        help="auto: cuda when available (default: params)",
+    )
+    parser.add_argument("--fresh", action="store_true", help="start over instead of resuming models/last.pt")
     parser.add_argument("--labels", default=None, help="the labels folder (default: params)")
     parser.add_argument("--graphs", default=None, help="the saved zone graphs folder (default: params)")
     parser.add_argument("--out", default=None, help="the folder for the model (default: params)")
@@ -287,8 +423,11 @@ def main() -> None:
     overrides = {k: v for k, v in paths.items() if v}  # the train stage's, from dvc.yaml
     if args.device:
         overrides["device"] = args.device
-    best = train(replace(config, **overrides))
-    print(f"train: best epoch {best['epoch']}, validation relative GT rank {best['val_rank']:.4f}")
+    best = train(replace(config, **overrides), fresh=args.fresh)
+    print(
+        f"train: best epoch {best['epoch']}: validation normalised GT rank {best['val_normalised']:.4f}, "
+        f"rank / P {best['val_rank']:.4f} (floor {best['val_floor']:.4f}), top-1 {best['val_top1']:.3f}"
+    )
 
 
 if __name__ == "__main__":

@@ -74,3 +74,34 @@ def test_bootstrap_resamples_designs_and_brackets_the_mean():
     assert bootstrap_mean(one) == pytest.approx((0.3, 0.3, 0.3))  # one design: no spread
     table = summarise(ranks)
     assert table.loc[0, "designs"] == 40 and table.loc[0, "steps"] == 120
+
+
+def test_every_scale_of_a_rank_and_its_hit_rates():
+    from zonegraph.sequence.rankers import gt_place
+
+    first = gt_place(np.array([0.9, 0.1, 0.2, 0.3]), np.array([True, False, False, False]))
+    assert (first.relative, first.normalised, first.floor, first.hit(1)) == (0.25, 0.0, 0.25, 1.0)
+    last = gt_place(np.array([0.0, 0.1, 0.2, 0.3]), np.array([True, False, False, False]))
+    assert (last.relative, last.normalised, last.hit(1), last.hit(5)) == (1.0, 1.0, 0.0, 1.0)
+    tied = gt_place(np.zeros(5), np.array([False, False, True, False, False]))  # all tied: random
+    assert tied.normalised == 0.5 and tied.hit(1) == pytest.approx(0.2) and tied.hit(5) == 1.0
+    assert np.isnan(gt_place(np.zeros(1), np.array([True])).normalised)
+
+
+@requires_samples
+def test_the_summary_counts_single_proposal_steps_and_pairs_ratios(labelled):
+    from eval.rank import markdown, ratios
+
+    labels, graphs, _ = labelled
+    ranks = guide_ranks(labels, graphs, make_guides(["heuristic", "random"], seed=3), "test")
+    table = summarise(ranks, seed=1).set_index("guide")
+    assert (table["steps"] + table["single"] == ranks.groupby("guide").size()).all()
+    for guide in ("heuristic", "random"):
+        row = table.loc[guide]
+        assert row["floor"] <= row["rank"] and 0 <= row["normalised"] <= 1 and row["top1"] <= row["top5"]
+        assert row["normalised_ci_low"] <= row["normalised"] <= row["normalised_ci_high"]
+    ratio = ratios(ranks, seed=1)
+    [(guide, value)] = ratio[["guide", "ratio"]].itertuples(index=False)
+    assert guide == "random"
+    assert value == pytest.approx(table.loc["random", "normalised"] / table.loc["heuristic", "normalised"])
+    assert "normalised rank" in markdown(summarise(ranks), ratio)

@@ -80,9 +80,7 @@ def test_every_dead_end_is_negative():
     # Plate with one hole, at the cut, with no slack: the other proposal removes the plate's web,
     # its inverse (adding the web back) is banned, and the plate extruded again from a side face
     # (a prism across the hole's wall) needs a step more than the design has: no completion.
-    graph, _, steps = _labelled(
-        PLATE - HOLE_A, [PLATE, HOLE_A], ["new_body", "cut"], slack=0, multiplier=20
-    )
+    graph, _, steps = _labelled(PLATE - HOLE_A, [PLATE, HOLE_A], ["new_body", "cut"], slack=0, multiplier=20)
     _check_invariants(graph, steps)
     others = _others(steps[1])
     assert others and all(x.p == 0.0 and x.label == NEGATIVE for x in others)
@@ -140,3 +138,32 @@ def test_real_samples_keep_the_invariants_and_write_readable_shards(samples_dir,
     again = label_and_save(str(tmp_path / "graph"), rows, "sample", "train", str(tmp_path / "again"))
     assert again == counts
     assert pq.read_table(tmp_path / "again" / "proposals" / "sample.parquet").equals(proposals)
+
+
+def test_proposal_features_are_the_heuristic_terms_and_the_geometry_the_search_sees():
+    from zonegraph.sequence.features import FEATURES, proposal_features
+    from zonegraph.sequence.rankers import HeuristicRanker
+
+    graph, ops, steps = _labelled(PLATE - HOLE_A, [PLATE, HOLE_A], ["new_body", "cut"], multiplier=0)
+    column = {name: i for i, name in enumerate(FEATURES)}
+    for step in steps:
+        props = [x.proposal for x in step.proposals]
+        feats = step.features
+        assert feats.shape == (len(props), len(FEATURES)) and np.isfinite(feats).all()
+        np.testing.assert_array_equal(feats, proposal_features(graph, step.canvas, props, step.step))
+        heuristic = HeuristicRanker().score(graph, step.canvas, props)
+        np.testing.assert_allclose(
+            feats[:, column["agree_after"]], np.floor(heuristic * graph.n_zones) / graph.n_zones, atol=1e-6
+        )
+        assert (feats[:, column["step"]] == step.step).all()
+        assert (feats[:, column["union"]] == [float(p.op.name == "UNION") for p in props]).all()
+        gt = feats[[x.is_gt for x in step.proposals]][0]
+        assert (
+            gt[column["iou_gain"]] > 0 and gt[column["start_on_target"]] == gt[column["end_on_target"]] == 1
+        )
+        # the plate is 1 thick in a box of unit diagonal: every plate-high extrusion has one depth
+        assert gt[column["depth"]] > 0 and gt[column["sketch_area"]] > 0 and gt[column["sketch_faces"]] >= 1
+    first, second = steps[0].features, steps[1].features
+    assert (first[:, column["missing"]] == 1).all() and (second[:, column["missing"]] == 0).all()
+    table, _ = label_tables(steps, ops, "part", "train")
+    assert [f"feat_{n}" for n in FEATURES] == table.column_names[-len(FEATURES) :]

@@ -211,3 +211,82 @@ def test_an_ablation_variant_trains_once_then_is_reused(labelled, tmp_path, monk
         "rounds0", replace(configs["rounds0"], lr=configs["rounds0"].lr * 10), tmp_path / "out"
     )
     assert other.stat().st_mtime_ns != written  # another config: trained again
+
+
+def test_listwise_loss_is_a_softmax_over_each_state_with_the_gt_as_target():
+    from training.loss import listwise_loss
+
+    logits = torch.tensor([[0.0, 2.0], [0.0, 0.0], [0.0, 1.0], [1.0, 0.0], [0.0, 0.0]], requires_grad=True)
+    state = torch.tensor([0, 0, 0, 1, 1])
+    gt = torch.tensor([1.0, 0, 0, 0, 1])
+    loss = listwise_loss(logits, state, gt)
+    score = logits[:, 1] - logits[:, 0]
+    expected = -(torch.log_softmax(score[:3], 0)[0] + torch.log_softmax(score[3:], 0)[1]) / 2
+    assert torch.allclose(loss, expected)
+    loss.backward()
+    assert logits.grad[0, 1] < 0 < logits.grad[1, 1]  # the GT's score goes up, the others' down
+    credit = listwise_loss(logits, state, torch.tensor([1.0, 0.5, 0, 0, 1]))
+    assert credit > loss  # a neutral sharing the target: the GT alone on top is no longer ideal
+    assert (
+        listwise_loss(logits, state, torch.tensor([0.0, 0, 0, 0, 1])) == -torch.log_softmax(score[3:], 0)[1]
+    )
+
+
+@requires_samples
+def test_proposal_features_reach_the_scorer_and_change_its_scores(labelled):
+    from zonegraph.sequence.features import FEATURES
+
+    data = LabelDataset(labelled / "labels", labelled / "graphs", mode="rank", points_per_zone=16)
+    assert data.has_features
+    state = max(data.states, key=lambda s: len(s.labels))
+    assert state.features.shape == (len(state.labels), len(FEATURES)) and state.features.any()
+    batch = next(iter(DataLoader([data.get(data.states.index(state))], batch_size=1)))
+    torch.manual_seed(0)
+    model = ProposalScorer(ModelConfig(features=FEATURES)).eval()
+    with torch.no_grad():
+        plain = forward(model, batch)
+        batch.feat = batch.feat + 1.0
+        shifted = forward(model, batch)
+    assert not torch.allclose(plain, shifted)
+    with pytest.raises(ValueError, match="unknown proposal feature"):
+        ProposalScorer(ModelConfig(features=("nope",)))
+
+
+@pytest.mark.slow
+@requires_samples
+def test_a_stopped_run_resumes_from_its_last_epoch_in_the_same_mlflow_run(labelled, tmp_path, monkeypatch):
+    import mlflow
+
+    from zonegraph.sequence.features import FEATURES
+
+    monkeypatch.chdir(tmp_path)
+    base = TrainConfig(
+        labels_dir=str(labelled / "labels"),
+        graphs_dir=str(labelled / "graphs"),
+        epochs=2,
+        val_fraction=0.34,
+        points_per_zone=16,
+        batch_states=2,
+        loss="listwise",
+        neutral_credit=0.3,
+        features=FEATURES,
+        rounds=1,
+    )
+    train(replace(base, out_dir="broken", epochs=1))
+    after_one = torch.load(tmp_path / "broken" / "last.pt", weights_only=True)
+    train(replace(base, out_dir="broken"))  # the same settings, more epochs: continues
+    broken = torch.load(tmp_path / "broken" / "last.pt", weights_only=True)
+    assert broken["epoch"] == 2 and broken["run_id"] == after_one["run_id"]
+    assert broken["curve"][0] == after_one["curve"][0] and [r["epoch"] for r in broken["curve"]] == [1, 2]
+    # Two unbroken CPU runs already differ by ~1e-2 (threaded float reductions, amplified by Adam),
+    # so the weights cannot be compared with an unbroken run's; the resumed epoch trained on them.
+    moved = max(
+        float((broken["model"][k].float() - t.float()).abs().max()) for k, t in after_one["model"].items()
+    )
+    assert moved > 1e-3
+    client = mlflow.tracking.MlflowClient(tracking_uri="sqlite:///mlflow.db")
+    history = client.get_metric_history(broken["run_id"], "val_normalised")
+    assert sorted(m.step for m in history) == [1, 2]  # one MLflow run across the interruption
+    assert json.loads((tmp_path / "broken" / "metrics.json").read_text())["run_id"] == broken["run_id"]
+    train(replace(base, out_dir="broken", lr=0.01), fresh=False)  # other settings: a new run
+    assert torch.load(tmp_path / "broken" / "last.pt", weights_only=True)["run_id"] != broken["run_id"]

@@ -4,7 +4,10 @@ One state (a canvas and P proposals) is a graph holding one copy of the design's
 proposal, each zone with its four flags (in target, in canvas, in extrusion, operation), so that
 PyG's batching stacks proposals and states alike; ``proposal`` maps zones to proposals and
 ``zone_of`` to rows of ``points`` (the design's zones, stored once per state, with
-``zone_edge_index`` between them). The search encodes the graph it is searching; the training
+``zone_edge_index`` between them). Per proposal it carries its features (``feat``, (P, F): every
+column of :data:`zonegraph.sequence.features.FEATURES`; a model reads those its configuration
+names) and ``state``, the state it belongs to once batched (a listwise loss normalises over a
+state's proposals). The search encodes the graph it is searching; the training
 labels (``training.data``) encode the saved graphs the same way.
 """
 
@@ -17,6 +20,7 @@ import torch
 from torch import Tensor
 from torch_geometric.data import Data
 
+from zonegraph.sequence.features import FEATURES
 from zonegraph.zones.model import ZoneGraph
 
 
@@ -61,17 +65,29 @@ class StateData(Data):
             return int(self.num_proposals)
         if key in ("zone_of", "zone_edge_index"):
             return int(self.points.shape[0])
+        if key == "state":
+            return 1
         return int(super().__inc__(key, value, *args, **kwargs))
 
 
-def state_data(geometry: Geometry, canvas: Tensor, zones: Tensor, ops: Tensor, **extra: Tensor) -> StateData:
+def state_data(
+    geometry: Geometry,
+    canvas: Tensor,
+    zones: Tensor,
+    ops: Tensor,
+    features: Tensor | None = None,
+    **extra: Tensor,
+) -> StateData:
     """Flags and the proposal-replicated graph of one state.
 
     Shapes:
         canvas: (Z,) bool; zones: (P, Z) bool, the proposals' extrusions; ops: (P,) +1 union,
-        -1 subtract. Returns nodes P x Z with ``x`` (N, 4) flags.
+        -1 subtract; features: (P, F) float (zeros when not given). Returns nodes P x Z with
+        ``x`` (N, 4) flags.
     """
     p, z = zones.shape
+    if features is None:
+        features = torch.zeros(p, len(FEATURES))
     flags = torch.stack(
         [
             geometry.inside.expand(p, z).float(),
@@ -92,5 +108,7 @@ def state_data(geometry: Geometry, canvas: Tensor, zones: Tensor, ops: Tensor, *
         zone_edge_index=geometry.edge_index,
         num_proposals=p,
         num_nodes=p * z,
+        feat=features.float(),
+        state=torch.zeros(p, dtype=torch.long),
         **extra,
     )

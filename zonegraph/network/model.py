@@ -17,6 +17,11 @@ Three ways to bring the flags in, all selectable:
   (outside the extrusion, in a union's, in a subtraction's), computed once per state, and a
   proposal is a masked max over them: scoring costs element-wise work per proposal, no matmul.
 
+Proposal features (``ModelConfig.features``, names from :mod:`zonegraph.sequence.features`: the
+heuristic's terms, the extrusion's geometry, the step) join after the pool: standardised by a
+BatchNorm, embedded by a small MLP and concatenated to the pooled zone code before the readout,
+in every fusion. An empty tuple is the paper's network (and every checkpoint trained before).
+
 Shapes follow PyG: zones of all proposals in a batch are stacked ((N, ...) with ``batch`` the
 proposal of each zone), ``edge_index`` (2, E) holds both directions of every adjacency.
 """
@@ -31,6 +36,7 @@ from torch import Tensor, nn
 from torch_geometric.nn import MessagePassing, global_max_pool
 
 from zonegraph.configs import Config
+from zonegraph.sequence.features import FEATURES
 
 FLAGS = 4  # in target, in canvas, in extrusion, operation
 HIDDEN = 128
@@ -38,12 +44,22 @@ HIDDEN = 128
 
 @dataclass(frozen=True)
 class ModelConfig(Config):
-    """What the ablations vary: the fusion, the rounds of message passing, the point geometry."""
+    """What the ablations vary: the fusion, the rounds of message passing, the point geometry,
+    the proposal features read beside the zones."""
 
     fusion: str = "late"  # "early", "late" or "factored"
     rounds: int = 3
     use_points: bool = True  # False: zones are their flags only (the geometry ablation)
     hidden: int = HIDDEN
+    features: tuple[str, ...] = ()  # names of zonegraph.sequence.features.FEATURES; () the paper's
+
+    def feature_columns(self) -> list[int]:
+        """Columns of the data's ``feat`` this model reads."""
+        unknown = sorted(set(self.features) - set(FEATURES))
+        if unknown:
+            known = ", ".join(FEATURES)
+            raise ValueError(f"unknown proposal feature(s) {', '.join(unknown)} (known: {known})")
+        return [FEATURES.index(name) for name in self.features]
 
 
 def _mlp(sizes: list[int], last_plain: bool = True) -> nn.Sequential:
@@ -124,7 +140,14 @@ class ProposalScorer(nn.Module):
         else:
             self.zone_in = nn.Identity()
         self.rounds = nn.ModuleList(ZoneMessages(h) for _ in range(config.rounds))
-        self.readout = nn.Sequential(_mlp([h, h, h], last_plain=False), nn.Linear(h, 2))
+        self.columns = config.feature_columns()
+        extra = 0
+        if self.columns:
+            extra = h // 2
+            self.features_in = nn.Sequential(
+                nn.BatchNorm1d(len(self.columns)), _mlp([len(self.columns), extra, extra], last_plain=False)
+            )
+        self.readout = nn.Sequential(_mlp([h + extra, h, h], last_plain=False), nn.Linear(h, 2))
 
     def encode_geometry(self, points: Tensor) -> Tensor | None:
         """Per-graph zone codes (late and factored fusion), (Z, hidden) from (Z, 6, S) samples."""
@@ -149,7 +172,13 @@ class ProposalScorer(nn.Module):
             x = self.zone_in(torch.cat(parts, dim=1))
         for layer in self.rounds:
             x = layer(x, data.edge_index)
-        return self.readout(global_max_pool(x, data.proposal))
+        return self._readout(global_max_pool(x, data.proposal), data)
+
+    def _readout(self, pooled: Tensor, data: Any) -> Tensor:
+        """Logits from the pooled zone codes (P, hidden) and the proposal features, when read."""
+        if not self.columns:
+            return self.readout(pooled)
+        return self.readout(torch.cat([pooled, self.features_in(data.feat[:, self.columns])], dim=1))
 
     def _factored(self, data: Any, geometry: Tensor | None) -> Tensor:
         state_flags = torch.zeros(data.points.shape[0], 2, device=data.x.device)
@@ -160,7 +189,7 @@ class ProposalScorer(nn.Module):
         kinds = torch.eye(3, device=x.device)
         codes = torch.stack([self.extrusion(torch.cat([x, k.expand(len(x), 3)], dim=1)) for k in kinds])
         kind = (data.x[:, 2] * torch.where(data.x[:, 3] < 0, 2.0, 1.0)).long()  # 0 out, 1 union, 2 subtract
-        return self.readout(global_max_pool(codes[kind, data.zone_of], data.proposal))
+        return self._readout(global_max_pool(codes[kind, data.zone_of], data.proposal), data)
 
     @torch.no_grad()
     def score(self, data: Any, geometry: Tensor | None = None) -> Tensor:

@@ -36,16 +36,20 @@ def score_state(
     ops: Tensor,
     device: torch.device,
     codes: Tensor | None = None,
+    features: Tensor | None = None,
 ) -> np.ndarray:
     """P(positive) of each proposal of one state, in eval mode.
 
     Shapes:
-        canvas: (Z,) bool; zones: (P, Z) bool; ops: (P,) +1 union, -1 subtract; returns (P,).
+        canvas: (Z,) bool; zones: (P, Z) bool; ops: (P,) +1 union, -1 subtract; features: (P, F)
+        (:mod:`zonegraph.sequence.features`; zeros when not given); returns (P,).
     """
     model.eval()
     size, scores = chunk_size(model, geometry), []
     for start in range(0, len(zones), size):
-        data = state_data(geometry, canvas, zones[start : start + size], ops[start : start + size])
+        chunk = slice(start, start + size)
+        feats = None if features is None else features[chunk]
+        data = state_data(geometry, canvas, zones[chunk], ops[chunk], feats)
         logits = model(Batch.from_data_list([data]).to(device), geometry=codes)
         scores.append(logits.softmax(dim=1)[:, 1].cpu())
     return torch.cat(scores).numpy() if scores else np.zeros(0)

@@ -21,7 +21,7 @@ import numpy as np
 from zonegraph.configs import Config
 from zonegraph.sequence.deadline import Deadline
 from zonegraph.sequence.proposals import Proposal, ProposalGenerator
-from zonegraph.sequence.rankers import Ranker, zone_iou
+from zonegraph.sequence.rankers import Ranker, score_step, zone_iou
 from zonegraph.zones.model import ZoneGraph
 
 
@@ -122,7 +122,7 @@ def search(
         counts.append(len(props))
         order: list[int] = []
         if props and not deadline.passed():  # past it, the search stops: nothing to score for
-            scores = np.asarray(ranker.score(graph, canvas, props), float)
+            scores = score_step(ranker, graph, canvas, props, len(path))
             order = np.argsort(-scores, kind="stable")[: config.k_at(len(path))].tolist()
         times.append(time.perf_counter() - start)
         return iter([props[i] for i in order])

@@ -13,6 +13,10 @@ split of one step into two count. p = the share of completions that reach the ta
 with p = 0 are negative; if none has p = 0, the one with the smallest p (the first in proposal
 order on ties) is negative; the rest are neutral.
 
+Every proposal row also carries its :mod:`zonegraph.sequence.features` (columns ``feat_<name>``),
+the numbers the network guide reads beside the zone flags, computed by the same function the
+search calls, so training and search see one definition.
+
 Costs are shared across all completions of a design: the generator's memoised sweeps and a
 canvas -> proposals cache (canvases as packed bit vectors). Everything random comes from one
 generator seeded by (seed, design id): the same seed gives the same labels.
@@ -28,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pyarrow as pa
 
+from zonegraph.sequence.features import FEATURES, proposal_features, target_surfaces
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
 
@@ -50,6 +55,7 @@ PROPOSAL_SCHEMA = pa.schema(
         ("p", pa.float32()),  # share of completions reaching the target; null for the GT
         ("completions", pa.int32()),
         ("is_gt", pa.bool_()),
+        *((f"feat_{name}", pa.float32()) for name in FEATURES),  # zonegraph.sequence.features
     ]
 )
 STEP_SCHEMA = pa.schema(
@@ -101,6 +107,7 @@ class LabelledStep:
     proposals: list[LabelledProposal] = field(default_factory=list)
     reason: str = ""
     seconds: float = 0.0
+    features: np.ndarray = field(default_factory=lambda: np.zeros((0, len(FEATURES)), np.float32))  # (P, F)
 
 
 class Completer:
@@ -175,12 +182,15 @@ def label_design(
     completer = Completer(graph, ProposalGenerator(graph, level=level), design_rng(seed, design_id))
     canvas = np.zeros(graph.n_zones, bool)
     banned: set[tuple[bytes, int]] = set()
+    on_target = target_surfaces(graph)
     out = []
     for i, step in enumerate(gt):
         t0 = time.perf_counter()
         labelled = LabelledStep(i, canvas, step.captured)
         if step.captured and step.op is not None:
             _label_step(labelled, completer, step, banned, len(gt) - i, multiplier, slack)
+            props = [x.proposal for x in labelled.proposals]
+            labelled.features = proposal_features(graph, canvas, props, i, on_target)
         else:
             labelled.reason = step.reason or "GT not captured at this level"
         labelled.seconds = time.perf_counter() - t0
@@ -256,9 +266,10 @@ def label_tables(
             "p": None if x.is_gt else x.p,
             "completions": x.completions,
             "is_gt": x.is_gt,
+            **{f"feat_{name}": float(v) for name, v in zip(FEATURES, st.features[j], strict=True)},
         }
         for st in steps
-        for x in st.proposals
+        for j, x in enumerate(st.proposals)
     ]
     rows = [
         {

@@ -71,6 +71,18 @@ class HeuristicRanker:
         return agree + iou / (graph.n_zones + 1)
 
 
+def score_step(
+    ranker: Ranker, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int
+) -> np.ndarray:
+    """(P,) scores of one state ``step`` operations deep: a ranker that reads the depth (the
+    network with proposal features: the step index is one of them) offers ``score_at``; every
+    other ranker is called through the protocol's ``score``."""
+    score_at = getattr(ranker, "score_at", None)
+    if score_at is not None:
+        return np.asarray(score_at(graph, canvas, proposals, step), float)
+    return np.asarray(ranker.score(graph, canvas, proposals), float)
+
+
 def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
     """The ranker a guide name stands for: ``heuristic``, ``random`` (seeded), or one that
     :mod:`zonegraph.plugins` loads by reference.
@@ -94,15 +106,60 @@ def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
     return ranker
 
 
-def relative_rank(scores: np.ndarray, is_gt: np.ndarray) -> float:
-    """The GT's rank among a state's proposals divided by their number (the paper's metric:
-    1/P when the GT scores highest, about 0.5 for random scores; ties count half).
+@dataclass(frozen=True)
+class GTPlace:
+    """Where the GT landed among a state's P proposals: ``above`` others scored higher, ``ties``
+    scored the same (ties are broken uniformly at random, so they count half in the rank).
+
+    Three scales of one rank: :attr:`relative` is the paper's rank / P (1/P at best, about
+    (P + 1) / 2P for random scores, so it depends on P), :attr:`normalised` is (rank - 1) / (P - 1)
+    (0 at best, 0.5 for random scores at any P; undefined for one proposal), :attr:`floor` is the
+    best possible rank / P of the state.
+    """
+
+    above: int
+    ties: int
+    proposals: int
+
+    @property
+    def rank(self) -> float:
+        """1-based rank, ties counting half."""
+        return 1 + self.above + 0.5 * self.ties
+
+    @property
+    def relative(self) -> float:
+        return self.rank / self.proposals
+
+    @property
+    def normalised(self) -> float:
+        return (self.rank - 1) / (self.proposals - 1) if self.proposals > 1 else float("nan")
+
+    @property
+    def floor(self) -> float:
+        return 1 / self.proposals
+
+    def hit(self, k: int) -> float:
+        """Probability that the GT is among the first ``k`` (under the random tie-break)."""
+        return float(np.clip((k - self.above) / (self.ties + 1), 0.0, 1.0))
+
+
+def gt_place(scores: np.ndarray, is_gt: np.ndarray) -> GTPlace:
+    """The GT's place among one state's scored proposals (a NaN score ranks last, never first).
 
     Shapes:
         scores: (P,) float, higher first; is_gt: (P,) bool with exactly one true.
     """
-    scores = np.where(np.isnan(scores), -np.inf, scores)  # a NaN score ranks last, never first
-    gt = float(scores[np.flatnonzero(is_gt)[0]])
-    others = np.delete(scores, np.flatnonzero(is_gt)[0])
-    rank = 1 + float((others > gt).sum()) + 0.5 * float((others == gt).sum())
-    return rank / len(scores)
+    scores = np.where(np.isnan(scores), -np.inf, np.asarray(scores, float))
+    at = int(np.flatnonzero(is_gt)[0])
+    gt, others = float(scores[at]), np.delete(scores, at)
+    return GTPlace(int((others > gt).sum()), int((others == gt).sum()), len(scores))
+
+
+def relative_rank(scores: np.ndarray, is_gt: np.ndarray) -> float:
+    """The GT's rank among a state's proposals divided by their number (the paper's metric:
+    1/P when the GT scores highest, about 0.5 for random scores at large P; ties count half).
+
+    Shapes:
+        scores: (P,) float, higher first; is_gt: (P,) bool with exactly one true.
+    """
+    return gt_place(scores, is_gt).relative
