@@ -45,6 +45,7 @@ bench: $(STAMP)
 
 # The MLflow dashboard on the project's tracking store: training and evaluation runs.
 ui: $(STAMP)
+	$(BIN)/python -m eval.tracking relocate
 	$(BIN)/mlflow ui --backend-store-uri sqlite:///mlflow.db --port $${PORT:-5000}
 
 clean:

@@ -12,6 +12,7 @@ import pandas as pd
 import pytest
 
 from eval.searches import Search, folder_targets, run_searches
+from eval.tracking import metric_name
 from zonegraph.configs import InferConfig
 from zonegraph.network.checkpoint import SHIPPED
 from zonegraph.testing import requires_samples
@@ -77,7 +78,7 @@ def test_report_on_a_folder_is_an_mlflow_run_with_metrics_and_plots(samples_dir,
         [run] = search_runs(url, "evaluation")
         metrics = {m["key"]: m["value"] for m in run["data"]["metrics"]}
         files = rest(url, f"artifacts/list?run_id={run['info']['run_id']}")["files"]
-    assert metrics["exact_at_1s.heuristic"] == 1.0 and 0 <= metrics["iou_at_1s.random"] <= 1
+    assert metrics["exact_at_1s/heuristic"] == 1.0 and 0 <= metrics["iou_at_1s/random"] <= 1
     assert {"report.md", "iou_time.png", "k_ablation.png", "curves.csv"} <= {f["path"] for f in files}
     curves = pd.read_csv(tmp_path / "out" / "curves.csv")
     assert set(curves["guide"]) == {"random", "heuristic"} and set(curves["k"]) == {1, 5}
@@ -86,5 +87,8 @@ def test_report_on_a_folder_is_an_mlflow_run_with_metrics_and_plots(samples_dir,
     strips = sorted(p.name for p in (tmp_path / "out").glob("strip_*.png"))
     assert strips and all(f"({name})" in report for name in strips)  # GT and heuristic side by side
     written = json.loads((tmp_path / "out" / "metrics.json").read_text())
-    assert written == {k: metrics[k] for k in written}  # plus the curves, as step metrics
-    assert {"iou_curve.heuristic_k1", "exact_curve.random_k5"} <= set(metrics)
+    assert {metric_name(k): v for k, v in written.items()} == {
+        metric_name(k): metrics[metric_name(k)] for k in written
+    }
+    assert {"iou_vs_ms/heuristic_k1", "exact_vs_ms/random_k5"} <= set(metrics)  # the curves, by search time
+    assert run["info"]["run_name"].startswith("evaluate ")
