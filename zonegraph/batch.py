@@ -47,7 +47,8 @@ class BatchJob:
     """What a batch runs per part and how a result becomes a row.
 
     ``run`` gets the target and its output folder and returns the isolated outcome; ``describe``
-    turns a successful outcome's value into the row's ``status`` and its columns' values."""
+    turns a successful outcome's value into the row's ``status``, its columns' values and
+    optionally its ``reason``."""
 
     command: str
     run: Callable[[Path, Path], Outcome]
@@ -144,7 +145,8 @@ def _run_part(job: BatchJob, part: Part, out: Path) -> PartRow:
     if outcome.ok:
         values = job.describe(outcome.value)
         status = Status(values.pop("status"))
-        return PartRow(part.name, str(part.path), status, True, "", round(outcome.seconds, 4), values)
+        reason = str(values.pop("reason", ""))  # why a part that ran is not exact, say
+        return PartRow(part.name, str(part.path), status, True, reason, round(outcome.seconds, 4), values)
     error = {"target": str(part.path), "status": outcome.status, "reason": outcome.reason}
     if outcome.detail:
         error["traceback"] = outcome.detail

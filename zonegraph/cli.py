@@ -24,6 +24,7 @@ from zonegraph.verified import REPLAY_RTOL
 if TYPE_CHECKING:  # imported where used, so that ``zonegraph --help`` loads nothing it need not
     from zonegraph.batch import BatchJob
     from zonegraph.isolation import Outcome
+    from zonegraph.reconstruction import InferResult
 
 EXIT_USER_ERROR = 2
 EXIT_BUG = 1
@@ -44,6 +45,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     tolerance = None if args.no_check else args.tolerance
+
     def run(scratch: Path) -> Outcome:
         return run_isolated(replay_and_save, (args.design, scratch, tolerance), timeout=args.timeout)
 
@@ -162,7 +164,7 @@ def _infer_job(config: InferConfig, timeout: float) -> BatchJob:
     from zonegraph.batch import BatchJob, Column
     from zonegraph.isolation import run_isolated
     from zonegraph.plugins import guide_factory
-    from zonegraph.reconstruction import InferResult, infer
+    from zonegraph.reconstruction import infer
 
     guide_factory(config.guide)
 
@@ -170,7 +172,13 @@ def _infer_job(config: InferConfig, timeout: float) -> BatchJob:
         return run_isolated(infer, (str(target), str(out), config), timeout=timeout)
 
     def values(r: InferResult) -> dict[str, Any]:
-        return {"status": r.status, "steps": r.steps, "zones": r.zones, "iou_brep": r.iou_brep}
+        return {
+            "status": r.status,
+            "steps": r.steps,
+            "zones": r.zones,
+            "iou_brep": r.iou_brep,
+            "reason": r.reason,
+        }
 
     columns = (
         Column("steps", "steps", "d"),
@@ -195,16 +203,24 @@ def _cmd_infer(args: argparse.Namespace) -> int:
     if not outcome.ok:
         return _fail(target, outcome)
     r = outcome.value
-    print(
-        f"{Path(target).name}: {r.status}, {r.steps} steps ({', '.join(r.operations)}), "
-        f"B-rep IoU {r.iou_brep:.6f}, zone IoU {r.iou_zone:.6f}"
-    )
-    print(
-        f"  {r.zones} zones, build {r.build_s:.2f} s, search {r.search_s:.2f} s "
-        f"(best after {r.time_to_best_s:.2f} s, {r.expansions} expansions), "
-        f"rebuild {r.rebuild_s:.2f} s, verify {r.verify_s:.2f} s -> {args.out}"
-    )
+    print(infer_summary(Path(target).name, r, args.out))
     return 0
+
+
+def infer_summary(name: str, r: InferResult, out: str | Path) -> str:
+    """The lines ``infer`` prints for one part: the outcome, the reason when not exact, the times."""
+    from zonegraph.reconstruction import plural
+
+    steps = f"{plural(r.steps, 'step')} ({', '.join(r.operations)})" if r.steps else "no step"
+    lines = [f"{name}: {r.status}, {steps}, B-rep IoU {r.iou_brep:.6f}, zone IoU {r.iou_zone:.6f}"]
+    if r.reason:
+        lines.append(f"  why: {r.reason}")
+    lines.append(
+        f"  {r.zones} zones, build {r.build_s:.2f} s, search {r.search_s:.2f} s "
+        f"(best after {r.time_to_best_s:.2f} s, {plural(r.expansions, 'expansion')}), "
+        f"rebuild {r.rebuild_s:.2f} s, verify {r.verify_s:.2f} s -> {out}"
+    )
+    return "\n".join(lines)
 
 
 def _cmd_convert(args: argparse.Namespace) -> int:
