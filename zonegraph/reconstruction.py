@@ -35,7 +35,7 @@ from zonegraph.sequence.diagnosis import diagnose
 from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou, build_program, execute
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
-from zonegraph.status import Status
+from zonegraph.status import Status, plural
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.storage import load_zone_graph
@@ -236,11 +236,6 @@ def reconstruct(
     return Reconstruction(
         *best, build_s=build_s, search_s=search_s, solids=solids, trace=trace, searches=searches
     )
-
-
-def plural(count: int, noun: str) -> str:
-    """``1 expansion``, ``2 expansions``."""
-    return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
 def _ending(result: SearchResult, simplified: bool) -> str:

@@ -43,4 +43,8 @@ def test_zone_mesh_export_opens_with_one_colour_per_side(tmp_path):
     assert len(mesh.faces) > 0
     colours = {tuple(c) for c in mesh.visual.face_colors.tolist()}
     assert len(colours) == 2  # inside and outside zones
-    assert mesh.bounds[1] - mesh.bounds[0] == pytest.approx(g.box[3:] - g.box[:3], abs=1e-6)
+    # in the part's own coordinates (a 4 x 4 x 1 box about the origin), not the graph's unit box
+    assert mesh.bounds.tolist() == [
+        pytest.approx([-2, -2, -0.5], abs=1e-6),
+        pytest.approx([2, 2, 0.5], abs=1e-6),
+    ]
