@@ -31,7 +31,7 @@ from zonegraph.export.verify import Export, run_script, verified_export
 from zonegraph.export.writers import write_outputs
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.deadline import Deadline
-from zonegraph.sequence.diagnosis import diagnose
+from zonegraph.sequence.diagnosis import Diagnosis, diagnose
 from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou, build_program, execute
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
@@ -112,7 +112,7 @@ class InferResult:
     config: dict[str, Any] = field(default_factory=dict)
     trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
     reason: str = ""  # why the result is not exact ("" when it is)
-    diagnosis: dict[str, Any] = field(default_factory=dict)  # the reason's figures (Diagnosis)
+    diagnosis: dict[str, Any] = field(default_factory=dict)  # the reason's figures (a Diagnosis)
     diagnose_s: float = 0.0
     files: list[str] = field(default_factory=list)  # the program files written (none for no step)
     script: str = field(default="", repr=False)  # sequence.py's text, not in result.json
@@ -288,6 +288,12 @@ def _why_not_exact(
     return {"reason": "; ".join([*lead, diagnosis.reason()]), "diagnosis": asdict(diagnosis)}
 
 
+def _exact_fields() -> dict[str, Any]:
+    """An exact result's ``reason`` and ``diagnosis``: empty, but with every key, so that a table
+    of exact results alone still has a ``diagnosis`` Parquet can write (a struct of no field fails)."""
+    return {"reason": "", "diagnosis": asdict(Diagnosis())}
+
+
 def _files(out: Path, states: list, render: bool) -> list[str]:
     """The program files written into ``out``, relative to it."""
     names = ["sequence.py", "sequence.json"]
@@ -346,7 +352,7 @@ def infer(
     verify_s = time.perf_counter() - started - rebuild_s
     exact = bool(iou >= EXACT_IOU)  # the rebuilt B-rep decides, not the zones it was found on
     started = time.perf_counter()
-    why = {} if exact else _why_not_exact(rec, target, program, rebuild_error)
+    why = _exact_fields() if exact else _why_not_exact(rec, target, program, rebuild_error)
     result = InferResult(
         status=Status.REBUILD_FAILED if rebuild_error else Status.EXACT if exact else Status.PARTIAL,
         exact=exact,
