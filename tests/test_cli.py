@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+import zonegraph
 from zonegraph.batch import collect_parts
 from zonegraph.cli import main
 from zonegraph.data.design import load_design
@@ -103,13 +104,13 @@ def test_batch_infer_writes_a_folder_per_part_and_a_summary(samples_dir, tmp_pat
     proc = _cli("infer", str(parts), "--out", str(out), "--budget", "1")
     assert proc.returncode == 2, proc.stderr
     assert "Traceback" not in proc.stderr
-    names = ["Couch", "Couch_2", "Pattern2_6c40bf33_0000", "SingleSketchExtrude", "corrupt"]
-    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == names  # stems; the .step copy: _2
+    names = ["Couch.json", "Couch.step", "Pattern2_6c40bf33_0000", "SingleSketchExtrude", "corrupt"]
+    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == names  # stems; a shared one: file names
     summary = json.loads((out / "summary.json").read_text())
     rows = {r["name"]: r for r in summary["parts"]}
     assert [r["name"] for r in summary["parts"]] == names  # sorted files, in order
     assert {n: rows[n]["status"] for n in names[:4]} == dict.fromkeys(names[:4], "exact")
-    assert rows["Couch_2"]["target"].endswith("Couch.step") and rows["Couch_2"]["iou_brep"] > 0.9999
+    assert rows["Couch.step"]["target"].endswith("Couch.step") and rows["Couch.step"]["iou_brep"] > 0.9999
     assert rows["corrupt"]["status"] == "invalid_input" and not rows["corrupt"]["ok"]
     assert rows["corrupt"]["reason"] and "\n" not in rows["corrupt"]["reason"]
     assert summary["totals"]["by_status"] == {"exact": 4, "invalid_input": 1}
@@ -139,16 +140,16 @@ def test_one_target_keeps_its_layout_and_several_files_make_a_batch(samples_dir,
     assert (several / "Pattern2_6c40bf33_0000" / "zones.parquet").is_file()
 
 
-def test_a_folder_stands_for_its_part_files_and_equal_stems_get_numbers(tmp_path):
+def test_a_folder_stands_for_its_part_files_and_equal_stems_keep_their_extensions(tmp_path):
     for name in ("b.step", "a.json", "a.STEP", "readme.md"):
         (tmp_path / name).write_text("")
     (tmp_path / "sub").mkdir()
     parts = collect_parts([str(tmp_path), str(tmp_path / "b.step"), str(tmp_path / "absent.brep")])
     assert [(p.name, p.path.name) for p in parts] == [
-        ("a", "a.STEP"),
-        ("a_2", "a.json"),
-        ("b", "b.step"),
-        ("b_2", "b.step"),
+        ("a.STEP", "a.STEP"),
+        ("a.json", "a.json"),
+        ("b.step", "b.step"),
+        ("b_2.step", "b.step"),  # the same file twice
         ("absent", "absent.brep"),  # kept, to fail as its own row
     ]
 
@@ -199,3 +200,27 @@ def test_a_folder_given_as_a_design_is_named_as_a_folder(tmp_path):
     proc = _cli("replay", str(tmp_path), "--out", str(tmp_path / "o"))
     assert proc.returncode == 2
     assert proc.stderr.strip() == f"zonegraph: error: {tmp_path}: invalid_input: is a folder, not a file"
+
+
+def test_help_lists_commands_in_use_order_with_defaults_choices_and_examples(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    top = capsys.readouterr().out
+    assert "{infer,build,replay,convert}" in top and "examples:" in top and "``" not in top
+    with pytest.raises(SystemExit):
+        main(["infer", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "--guide {heuristic,random,net}" in text and "(default: heuristic)" in text
+    assert "(default: 10.0)" in text and "(default: 5)" in text and "(default: None)" not in text
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"zonegraph {zonegraph.__version__}"
+
+
+def test_a_model_for_a_guide_that_uses_none_is_refused(samples_dir, tmp_path, capsys):
+    target = str(samples_dir / "SingleSketchExtrude.json")
+    assert main(["infer", target, "--out", str(tmp_path / "o"), "--model", "m.pt"]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    refusal = "zonegraph: error: --model m.pt: the heuristic guide uses no model (only --guide net does)"
+    assert lines == [refusal]
+    assert not (tmp_path / "o").exists()

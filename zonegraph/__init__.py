@@ -16,7 +16,9 @@ Typical use::
     import zonegraph as zg
     graph = zg.build_zone_graph(zg.load_target("part.step"))
     result = zg.search(graph, zg.HeuristicRanker(), zg.SearchConfig(budget_s=10))
-    zg.infer("part.step", "out/", zg.InferConfig(budget_s=20))   # search, rebuild, verify, export
+    answer = zg.infer("part.step", "out/", zg.InferConfig(budget_s=20))  # search ... export
+    part = answer.to_part()      # the program as a build123d Part (answer.reason: why not exact)
+    script, design = answer.to_script(), answer.to_json()  # sequence.py, sequence.json
 
 The public names below are imported on first use, so ``import zonegraph`` stays cheap (the
 geometry kernel loads only when a name that needs it is touched). There is no torch import here.
@@ -89,4 +91,9 @@ if TYPE_CHECKING:
     )
 
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, __all__)
+__getattr__, _ = lazy_exports(__name__, _EXPORTS, __all__)
+
+
+def __dir__() -> list[str]:
+    """The public API only: not this module's own helpers (``TYPE_CHECKING``, ``lazy_exports``)."""
+    return sorted([*__all__, "__version__"])

@@ -47,7 +47,8 @@ class BatchJob:
     """What a batch runs per part and how a result becomes a row.
 
     ``run`` gets the target and its output folder and returns the isolated outcome; ``describe``
-    turns a successful outcome's value into the row's ``status`` and its columns' values."""
+    turns a successful outcome's value into the row's ``status``, its columns' values and
+    optionally its ``reason``."""
 
     command: str
     run: Callable[[Path, Path], Outcome]
@@ -93,15 +94,19 @@ def _folder_parts(folder: Path) -> list[Path]:
 
 
 def name_parts(paths: Sequence[Path]) -> list[Part]:
-    """Each part's folder name: its file stem, or for a stem already taken (``a.json`` after
-    ``a.step``) the first free ``<stem>_2``, ``<stem>_3``...: the same names for the same command."""
+    """Each part's folder name: its file stem, or its file name where two files share a stem
+    (``Couch.json`` and ``Couch.step`` go to ``Couch.json/`` and ``Couch.step/``, so each folder
+    says which file it holds); a name still taken (one file named twice) gets ``_2``, ``_3``...
+    after its stem: the same names for the same command."""
+    stems = Counter(path.stem for path in paths)
     taken: set[str] = set()
     parts = []
     for path in paths:
-        name, n = path.stem, 1
+        suffix = "" if stems[path.stem] == 1 else path.suffix
+        name, n = path.stem + suffix, 1
         while name in taken:
             n += 1
-            name = f"{path.stem}_{n}"
+            name = f"{path.stem}_{n}{suffix}"
         taken.add(name)
         parts.append(Part(name, path))
     return parts
@@ -144,7 +149,8 @@ def _run_part(job: BatchJob, part: Part, out: Path) -> PartRow:
     if outcome.ok:
         values = job.describe(outcome.value)
         status = Status(values.pop("status"))
-        return PartRow(part.name, str(part.path), status, True, "", round(outcome.seconds, 4), values)
+        reason = str(values.pop("reason", ""))  # why a part that ran is not exact, say
+        return PartRow(part.name, str(part.path), status, True, reason, round(outcome.seconds, 4), values)
     error = {"target": str(part.path), "status": outcome.status, "reason": outcome.reason}
     if outcome.detail:
         error["traceback"] = outcome.detail

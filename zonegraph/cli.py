@@ -17,13 +17,15 @@ from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from zonegraph.configs import BuildConfig, InferConfig
+from zonegraph.configs import GUIDES, MODELLESS_GUIDES, BuildConfig, InferConfig
 from zonegraph.errors import ZoneGraphError
+from zonegraph.status import plural
 from zonegraph.verified import REPLAY_RTOL
 
 if TYPE_CHECKING:  # imported where used, so that ``zonegraph --help`` loads nothing it need not
     from zonegraph.batch import BatchJob
     from zonegraph.isolation import Outcome
+    from zonegraph.reconstruction import InferResult
 
 EXIT_USER_ERROR = 2
 EXIT_BUG = 1
@@ -44,6 +46,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     tolerance = None if args.no_check else args.tolerance
+
     def run(scratch: Path) -> Outcome:
         return run_isolated(replay_and_save, (args.design, scratch, tolerance), timeout=args.timeout)
 
@@ -52,7 +55,8 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         return _fail(args.design, outcome)
     summary = outcome.value
     print(
-        f"{summary['id']}: {len(summary['steps'])} extrudes, {summary['body_count']} bodies, "
+        f"{summary['id']}: {plural(len(summary['steps']), 'extrude')}, "
+        f"{plural(summary['body_count'], 'body', 'bodies')}, "
         f"{summary['face_count']} faces, volume {summary['volume']:.6g} cm^3 -> {out}"
     )
     check = summary.get("check")
@@ -151,6 +155,8 @@ def _guide_error(config: InferConfig) -> str | None:
     problem = guide_problem(config.guide)
     if problem is not None:
         return problem
+    if config.model is not None and config.guide in MODELLESS_GUIDES:
+        return f"--model {config.model}: the {config.guide} guide uses no model (only --guide net does)"
     if config.model is not None and not Path(config.model).is_file():
         return f"{config.model}: no such model checkpoint"
     return None
@@ -162,7 +168,7 @@ def _infer_job(config: InferConfig, timeout: float) -> BatchJob:
     from zonegraph.batch import BatchJob, Column
     from zonegraph.isolation import run_isolated
     from zonegraph.plugins import guide_factory
-    from zonegraph.reconstruction import InferResult, infer
+    from zonegraph.reconstruction import infer
 
     guide_factory(config.guide)
 
@@ -170,7 +176,13 @@ def _infer_job(config: InferConfig, timeout: float) -> BatchJob:
         return run_isolated(infer, (str(target), str(out), config), timeout=timeout)
 
     def values(r: InferResult) -> dict[str, Any]:
-        return {"status": r.status, "steps": r.steps, "zones": r.zones, "iou_brep": r.iou_brep}
+        return {
+            "status": r.status,
+            "steps": r.steps,
+            "zones": r.zones,
+            "iou_brep": r.iou_brep,
+            "reason": r.reason,
+        }
 
     columns = (
         Column("steps", "steps", "d"),
@@ -195,16 +207,22 @@ def _cmd_infer(args: argparse.Namespace) -> int:
     if not outcome.ok:
         return _fail(target, outcome)
     r = outcome.value
-    print(
-        f"{Path(target).name}: {r.status}, {r.steps} steps ({', '.join(r.operations)}), "
-        f"B-rep IoU {r.iou_brep:.6f}, zone IoU {r.iou_zone:.6f}"
-    )
-    print(
-        f"  {r.zones} zones, build {r.build_s:.2f} s, search {r.search_s:.2f} s "
-        f"(best after {r.time_to_best_s:.2f} s, {r.expansions} expansions), "
-        f"rebuild {r.rebuild_s:.2f} s, verify {r.verify_s:.2f} s -> {args.out}"
-    )
+    print(infer_summary(Path(target).name, r, args.out))
     return 0
+
+
+def infer_summary(name: str, r: InferResult, out: str | Path) -> str:
+    """The lines ``infer`` prints for one part: the outcome, the reason when not exact, the times."""
+    steps = f"{plural(r.steps, 'step')} ({', '.join(r.operations)})" if r.steps else "no step"
+    lines = [f"{name}: {r.status}, {steps}, B-rep IoU {r.iou_brep:.6f}, zone IoU {r.iou_zone:.6f}"]
+    if r.reason:
+        lines.append(f"  why: {r.reason}")
+    lines.append(
+        f"  {r.zones} zones, build {r.build_s:.2f} s, search {r.search_s:.2f} s "
+        f"(best after {r.time_to_best_s:.2f} s, {plural(r.expansions, 'expansion')}), "
+        f"rebuild {r.rebuild_s:.2f} s, verify {r.verify_s:.2f} s -> {out}"
+    )
+    return "\n".join(lines)
 
 
 def _cmd_convert(args: argparse.Namespace) -> int:
@@ -301,41 +319,57 @@ def _convert_summary(rows: list[dict[str, Any]]) -> str:
     return json.dumps({"counts": counts, "designs": rows}, indent=1)
 
 
+DESCRIPTION = (
+    "Recover editable sketch + extrude programs (build123d scripts and Fusion 360 Gallery JSON) "
+    "from B-rep solids with zone graphs."
+)
+EPILOG = """examples:
+  zonegraph infer part.step --out out/            # out/sequence.py, sequence.json, result.json
+  zonegraph infer parts/ extra.step --out out/ --budget 5   # a batch: out/<name>/, summary.json
+  zonegraph build part.step --out graph/          # the zone graph: Parquet, zones.brep, zones.ply
+  zonegraph replay design.json --out replay/      # a Fusion 360 Gallery design rebuilt as STEP
+  zonegraph convert corpus/01_2ops --out json/    # build123d corpus batches to design JSON
+
+A batch names each part's folder by its file stem, or by its file name where two files share a
+stem (Couch.json and Couch.step go to Couch.json/ and Couch.step/).
+"""
+
+
+class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Defaults shown after each option's help (not where there is none to show: a flag, or a
+    default the help explains itself), and the epilog's examples kept as written."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        if action.default is None or action.default is False or "default" in (action.help or ""):
+            return action.help
+        return super()._get_help_string(action)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="zonegraph", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("replay", help="replay a Fusion 360 Gallery design JSON with build123d")
-    p.add_argument("design", help="design JSON file")
-    p.add_argument("--out", required=True, help="output folder (final.step, steps/, summary.json)")
-    p.add_argument("--timeout", type=float, default=600.0, help="seconds before the replay is stopped")
-    p.add_argument(
-        "--tolerance",
-        type=float,
-        default=REPLAY_RTOL,
-        help="largest relative volume and area error against the file's properties (else exit 2)",
+    from zonegraph import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="zonegraph", description=DESCRIPTION, epilog=EPILOG, formatter_class=_HelpFormatter
     )
-    p.add_argument("--no-check", action="store_true", help="keep the result whatever the file's properties")
-    p.set_defaults(func=_cmd_replay)
-    p = sub.add_parser("build", help="build the zone graph of STEP/BREP parts or design JSON files")
-    p.add_argument("targets", nargs="+", metavar="target", help=f"PART.step, PART.brep, DESIGN.json {MANY}")
-    p.add_argument(
-        "--out", required=True, help=f"output folder (Parquet tables, zones.brep, zones.ply){PER_PART}"
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="{infer,build,replay,convert}")
+    _add_infer(sub)
+    _add_build(sub)
+    _add_replay(sub)
+    _add_convert(sub)
+    return parser
+
+
+def _command(sub: Any, name: str, help: str) -> argparse.ArgumentParser:
+    parser: argparse.ArgumentParser = sub.add_parser(
+        name, help=help, description=help[:1].upper() + help[1:] + ".", formatter_class=_HelpFormatter
     )
-    p.add_argument("--no-simplify", action="store_true", help="extend face-loop walls as full planes")
-    b = BuildConfig.defaults()
-    p.add_argument("--samples", type=int, default=b["samples"], help="surface samples per zone")
-    p.add_argument("--seed", type=int, default=b["seed"], help="seed of the surface samples")
-    p.add_argument("--timeout", type=float, default=600.0, help="seconds before a build is stopped")
-    p.set_defaults(func=_cmd_build)
-    p = sub.add_parser("convert", help="convert build123d corpus batches to verified design JSON")
-    p.add_argument("source", help="a batch_NNN.py file or a folder of them (searched recursively)")
-    p.add_argument("--out", required=True, help="output folder (one JSON per design, summary.json)")
-    p.add_argument(
-        "--timeout", type=float, default=120.0, help="seconds per design (each runs in its own process)"
-    )
-    p.set_defaults(func=_cmd_convert)
+    return parser
+
+
+def _add_infer(sub: Any) -> None:
     d = InferConfig.defaults()
-    p = sub.add_parser("infer", help="infer an editable sketch + extrude program that rebuilds a part")
+    p = _command(sub, "infer", "infer an editable sketch + extrude program that rebuilds a part")
     p.add_argument(
         "targets",
         nargs="+",
@@ -346,9 +380,14 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", required=True, help=f"output folder (result.json, sequence.py/.json/.png, steps/){PER_PART}"
     )
     p.add_argument(
-        "--guide", default=d["guide"], help="proposal ranking: heuristic, random or net (the train extra)"
+        "--guide",
+        default=d["guide"],
+        metavar="{" + ",".join(GUIDES) + "}",
+        help="proposal ranking (net: the network, with the train extra; or a ranker plugin's name)",
     )
-    p.add_argument("--model", default=None, help="network guide checkpoint (default: the shipped one)")
+    p.add_argument(
+        "--model", default=None, help="the net guide's checkpoint (default: the shipped one; net only)"
+    )
     p.add_argument(
         "--budget",
         dest="budget_s",
@@ -364,10 +403,51 @@ def build_parser() -> argparse.ArgumentParser:
         "--level", type=int, default=d["level"], help="proposal level (subsets of sketch components)"
     )
     p.add_argument(
-        "--timeout", type=float, default=None, help="hard stop per part in seconds (default 3 x budget + 300)"
+        "--timeout",
+        type=float,
+        default=None,
+        help="hard stop per part in seconds (default: 3 x budget + 300)",
     )
     p.set_defaults(func=_cmd_infer)
-    return parser
+
+
+def _add_build(sub: Any) -> None:
+    b = BuildConfig.defaults()
+    p = _command(sub, "build", "build the zone graph of STEP/BREP parts or design JSON files")
+    p.add_argument("targets", nargs="+", metavar="target", help=f"PART.step, PART.brep, DESIGN.json {MANY}")
+    p.add_argument(
+        "--out", required=True, help=f"output folder (Parquet tables, zones.brep, zones.ply){PER_PART}"
+    )
+    p.add_argument("--no-simplify", action="store_true", help="extend face-loop walls as full planes")
+    p.add_argument("--samples", type=int, default=b["samples"], help="surface samples per zone")
+    p.add_argument("--seed", type=int, default=b["seed"], help="seed of the surface samples")
+    p.add_argument("--timeout", type=float, default=600.0, help="seconds before a build is stopped")
+    p.set_defaults(func=_cmd_build)
+
+
+def _add_replay(sub: Any) -> None:
+    p = _command(sub, "replay", "replay a Fusion 360 Gallery design JSON with build123d")
+    p.add_argument("design", help="design JSON file")
+    p.add_argument("--out", required=True, help="output folder (final.step, steps/, summary.json)")
+    p.add_argument("--timeout", type=float, default=600.0, help="seconds before the replay is stopped")
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=REPLAY_RTOL,
+        help="largest relative volume and area error against the file's properties (else exit 2)",
+    )
+    p.add_argument("--no-check", action="store_true", help="keep the result whatever the file's properties")
+    p.set_defaults(func=_cmd_replay)
+
+
+def _add_convert(sub: Any) -> None:
+    p = _command(sub, "convert", "convert build123d corpus batches to verified design JSON")
+    p.add_argument("source", help="a batch_NNN.py file or a folder of them (searched recursively)")
+    p.add_argument("--out", required=True, help="output folder (one JSON per design, summary.json)")
+    p.add_argument(
+        "--timeout", type=float, default=120.0, help="seconds per design (each runs in its own process)"
+    )
+    p.set_defaults(func=_cmd_convert)
 
 
 # Arguments that must be positive where a command has them (0 or less ran a search of no steps).

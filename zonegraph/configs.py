@@ -149,19 +149,27 @@ class BuildConfig(Config):
     seed: int = 0
 
 
+# The guides zonegraph itself offers (``zonegraph.plugins`` runs them; it is not imported here, as
+# reading entry points costs ``zonegraph --help`` a tenth of a second), and those that take no model.
+GUIDES = ("heuristic", "random", "net")
+MODELLESS_GUIDES = ("heuristic", "random")
+
+
 @dataclass(frozen=True)
 class InferConfig(Config):
     """Search settings of one reconstruction (``zonegraph infer``, the ``reconstruct`` stage).
 
     Args:
-        guide: proposal ranking, ``heuristic``, ``random`` or an installed plugin (``net``).
+        guide: proposal ranking: ``heuristic``, ``random``, ``net`` (the shipped network, behind
+            the ``train`` extra) or a ranker plugin another package registers.
         budget_s: search seconds over both graphs (zone-graph build excluded, as in the paper).
         k: proposals kept per state (top-k).
         k_decay: decrease of k per depth level (the paper's harder runs: k 15, decay 0.5).
         max_depth: longest program searched.
         seed: seed of the random guide.
         level: proposal level: sketches of 1..level and N-level..N components.
-        model: the network guide's checkpoint (None: the shipped one).
+        model: the network guide's checkpoint (None: the shipped one); the built-in guides use
+            none, so the CLI refuses one with them.
     """
 
     guide: str = "heuristic"

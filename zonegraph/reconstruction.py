@@ -4,8 +4,13 @@ The simplified zone graph is searched first (fewer zones, faster); if it yields 
 the unsimplified graph gets the rest of the budget (face-loop strips can leave zones that no prism
 fills, as on slanted walls), unless simplification found no face loop and the two graphs are one.
 The best program found is rebuilt from its sketches and measured against the target with B-rep
-Booleans, whether or not it is exact. The budget bounds the search alone, each graph's proposal
-generator set-up included; building the graphs, rebuilding and verifying are timed apart.
+Booleans, whether or not it is exact, and written out whenever it has a step: a partial program is
+still a start for the user. A result that is not exact carries a ``reason``
+(:mod:`zonegraph.sequence.diagnosis`): the target faces no extrusion can make, whether the zone
+graph can hold the target at all, and how each search ended. A search that found no step writes no
+program files (an empty script would look like an answer); its ``reason`` says so first.
+The budget bounds the search alone, each graph's proposal generator set-up included; building the
+graphs, rebuilding, diagnosing and verifying are timed apart.
 """
 
 from __future__ import annotations
@@ -17,25 +22,35 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from build123d import Shape, Solid, Unit
+from build123d import Part, Shape, Solid, Unit
 
 from zonegraph.configs import InferConfig
 from zonegraph.data.replay import as_shape
 from zonegraph.data.targets import load_target
-from zonegraph.export.verify import Export, verified_export
+from zonegraph.export.verify import Export, run_script, verified_export
 from zonegraph.export.writers import write_outputs
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.deadline import Deadline
+from zonegraph.sequence.diagnosis import Diagnosis, diagnose
 from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou, build_program, execute
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
-from zonegraph.status import Status
+from zonegraph.status import Status, plural
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
 from zonegraph.zones.storage import load_zone_graph
 
 EXACT_IOU = 0.9999
 FIRST_SHARE = 0.5  # of the budget, for the simplified graph
+# Seconds for the diagnosis's sweeps of every face over every plane pair (outside the budget, as the
+# rebuild is); the fillet-box test part's 297 zones take 0.1 s.
+DIAGNOSIS_S = 5.0
+ENDINGS = {
+    "exhausted": "exhausted its space",
+    "budget": "ran out of budget",
+    "expansions": "reached its expansion limit",
+    "exact": "found an exact canvas",
+}
 
 
 @dataclass
@@ -49,6 +64,7 @@ class Reconstruction:
     search_s: float  # search seconds (both graphs, generator set-up included)
     solids: list[Solid]  # the target, in the input's units
     trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
+    searches: list[str] = field(default_factory=list)  # how each graph's search ended, in words
 
     @property
     def time_to_best_s(self) -> float:
@@ -58,7 +74,19 @@ class Reconstruction:
 
 @dataclass
 class InferResult:
-    """What ``zonegraph infer`` found: the contents of ``result.json``."""
+    """What ``zonegraph infer`` found: the metrics of ``result.json`` and the program itself.
+
+    The program is kept as the texts written to ``sequence.py`` and ``sequence.json`` (verified by
+    ``script_iou`` and ``json_iou``), so that a result crosses a process boundary as plain data;
+    :meth:`to_part` runs the script. A result of no step has no program: those methods raise.
+
+    Example (a part whose program is exact rebuilds to the target's volume)::
+
+        result = zg.infer("part.step", "out/")
+        part = result.to_part()        # a build123d Part, in the input's units and position
+        text = result.to_script()      # sequence.py
+        design = result.to_json()      # sequence.json (Fusion 360 Gallery format)
+    """
 
     status: Status  # exact, partial or rebuild_failed
     exact: bool  # rebuilt with B-rep IoU >= EXACT_IOU (a zone sliver short of the target can be)
@@ -83,10 +111,50 @@ class InferResult:
     verify_s: float = 0.0  # snapping, checking and writing the script and JSON
     config: dict[str, Any] = field(default_factory=dict)
     trace: list[tuple[float, float]] = field(default_factory=list)  # anytime (search s, best zone IoU)
+    reason: str = ""  # why the result is not exact ("" when it is)
+    diagnosis: dict[str, Any] = field(default_factory=dict)  # the reason's figures (a Diagnosis)
+    diagnose_s: float = 0.0
+    files: list[str] = field(default_factory=list)  # the program files written (none for no step)
+    script: str = field(default="", repr=False)  # sequence.py's text, not in result.json
+    design: str = field(default="", repr=False)  # sequence.json's text, not in result.json
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data (the status as its string), for ``result.json`` and the pipeline's tables."""
-        return {**asdict(self), "status": self.status.value}
+        """Plain data (the status as its string), for ``result.json`` and the pipeline's tables:
+        the metrics, not the program texts (they are the files beside it)."""
+        data = {**asdict(self), "status": self.status.value}
+        del data["script"], data["design"]
+        return data
+
+    def to_script(self) -> str:
+        """The editable build123d script (``sequence.py``).
+
+        Raises:
+            ValueError: the search found no step, so there is no program.
+        """
+        return self._program(self.script)
+
+    def to_json(self) -> str:
+        """The program in Fusion 360 Gallery format (``sequence.json``), as ``zonegraph replay``
+        reads it.
+
+        Raises:
+            ValueError: the search found no step, so there is no program.
+        """
+        return self._program(self.design)
+
+    def to_part(self) -> Part:
+        """The program's shape as a build123d ``Part``, by running the written script.
+
+        Raises:
+            ValueError: the search found no step, so there is no program.
+        """
+        shape = run_script(self.to_script())
+        return shape if isinstance(shape, Part) else Part(shape.wrapped)
+
+    def _program(self, text: str) -> str:
+        if not text:
+            raise ValueError(f"no program was found: {self.reason or self.rebuild_error}")
+        return text
 
 
 def input_unit(path: Path) -> Unit:
@@ -140,6 +208,7 @@ def reconstruct(
     best: tuple[ZoneGraph, ProposalGenerator, SearchResult] | None = None
     build_s, search_s = 0.0, 0.0
     trace: list[tuple[float, float]] = []
+    searches: list[str] = []
     error: ZoneGraphBuildError | None = None
     for simplify in (True, False):
         try:
@@ -158,12 +227,23 @@ def reconstruct(
             trace += _improvements(result, search_s + setup, best[2].iou if best else -1.0)
             best = (graph, gen, result)
         search_s += setup + result.seconds
+        searches.append(_ending(result, simplify))
         if result.exact or not graph.surface_strip.any():  # no face loop: the full graph is the same
             break
     if best is None:
         assert error is not None
         raise error
-    return Reconstruction(*best, build_s=build_s, search_s=search_s, solids=solids, trace=trace)
+    return Reconstruction(
+        *best, build_s=build_s, search_s=search_s, solids=solids, trace=trace, searches=searches
+    )
+
+
+def _ending(result: SearchResult, simplified: bool) -> str:
+    graph = "simplified" if simplified else "full"
+    return (
+        f"{ENDINGS[result.ended]} on the {graph} graph after {plural(result.expansions, 'expansion')} "
+        f"({result.seconds:.2f} s)"
+    )
 
 
 def _improvements(result: SearchResult, offset: float, above: float) -> list[tuple[float, float]]:
@@ -197,6 +277,32 @@ def _disagreement(rebuilt: Shape | None, target: Shape, iou: float) -> str:
     )
 
 
+def _why_not_exact(
+    rec: Reconstruction, target: Shape, program: list[ProgramStep], rebuild_error: str
+) -> dict[str, Any]:
+    """The ``reason`` and ``diagnosis`` fields of a result that is not exact."""
+    diagnosis = diagnose(target.wrapped, rec.generator, rec.searches, DIAGNOSIS_S)
+    lead = [rebuild_error] if rebuild_error else []
+    if not program and not rebuild_error:
+        lead.append("no step found, so no program was written")
+    return {"reason": "; ".join([*lead, diagnosis.reason()]), "diagnosis": asdict(diagnosis)}
+
+
+def _exact_fields() -> dict[str, Any]:
+    """An exact result's ``reason`` and ``diagnosis``: empty, but with every key, so that a table
+    of exact results alone still has a ``diagnosis`` Parquet can write (a struct of no field fails)."""
+    return {"reason": "", "diagnosis": asdict(Diagnosis())}
+
+
+def _files(out: Path, states: list, render: bool) -> list[str]:
+    """The program files written into ``out``, relative to it."""
+    names = ["sequence.py", "sequence.json"]
+    if render:
+        names += [f"steps/{i:02d}.step" for i, state in enumerate(states) if state is not None]
+        names.append("sequence.png")
+    return names
+
+
 def infer(
     target_path: str | Path,
     out: str | Path,
@@ -216,7 +322,8 @@ def infer(
         saved_graph: a folder holding this target's zone graph, reused instead of rebuilt.
 
     Returns:
-        The result, also written to ``out/result.json``.
+        The result, also written to ``out/result.json``; when not exact, its ``reason`` says why.
+        A search that found no step writes no program files (its reason says so).
 
     Raises:
         InputError, ZoneGraphBuildError: as :func:`reconstruct`.
@@ -244,6 +351,8 @@ def infer(
         write_outputs(export.script, export.design, program, states, out_dir, unit, render)
     verify_s = time.perf_counter() - started - rebuild_s
     exact = bool(iou >= EXACT_IOU)  # the rebuilt B-rep decides, not the zones it was found on
+    started = time.perf_counter()
+    why = _exact_fields() if exact else _why_not_exact(rec, target, program, rebuild_error)
     result = InferResult(
         status=Status.REBUILD_FAILED if rebuild_error else Status.EXACT if exact else Status.PARTIAL,
         exact=exact,
@@ -264,6 +373,11 @@ def infer(
         verify_s=verify_s,
         config=asdict(config),
         trace=rec.trace,
+        **why,
+        diagnose_s=time.perf_counter() - started,
+        files=_files(out_dir, states, render) if export else [],
+        script=export.script if export else "",
+        design=export.design if export else "",
     )
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "result.json").write_text(json.dumps(result.to_dict(), indent=2))

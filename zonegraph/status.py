@@ -50,3 +50,8 @@ class Status(str, enum.Enum):
 
     def __str__(self) -> str:
         return self.value
+
+
+def plural(count: int, noun: str, many: str = "") -> str:
+    """``1 expansion``, ``2 expansions``, ``3 bodies``: the counts every message of an outcome gives."""
+    return f"{count} {noun if count == 1 else many or noun + 's'}"

@@ -57,6 +57,7 @@ def test_a_deadline_passed_mid_expansion_stops_the_search_there(graph):
     assert deadline.checks <= checks // 2 + 3
     assert result.expansions == 1 and result.steps == [] and not result.exact
     assert not result.canvas.any()  # the best so far: the empty canvas
+    assert result.ended == "budget"  # what the reason of a partial result reports
 
 
 def test_an_interrupted_generator_finishes_later_as_a_fresh_one(graph):
@@ -77,3 +78,4 @@ def test_an_unbounded_deadline_changes_nothing(graph):
     ]
     assert [p.key for p in runs[0].steps] == [p.key for p in runs[1].steps]
     assert runs[0].proposals_per_state == runs[1].proposals_per_state
+    assert {r.ended for r in runs} <= {"exact", "expansions"}

@@ -43,7 +43,11 @@ def test_zone_mesh_export_opens_with_one_colour_per_side(tmp_path):
     assert len(mesh.faces) > 0
     colours = {tuple(c) for c in mesh.visual.face_colors.tolist()}
     assert len(colours) == 2  # inside and outside zones
-    assert mesh.bounds[1] - mesh.bounds[0] == pytest.approx(g.box[3:] - g.box[:3], abs=1e-6)
+    # in the part's own coordinates (a 4 x 4 x 1 box about the origin), not the graph's unit box
+    assert mesh.bounds.tolist() == [
+        pytest.approx([-2, -2, -0.5], abs=1e-6),
+        pytest.approx([2, 2, 0.5], abs=1e-6),
+    ]
 
 
 def test_samples_are_trimeshs_surface_sampler_draws():
@@ -65,4 +69,4 @@ def test_zone_mesh_file_reads_back_as_the_zone_triangles(tmp_path):
     g = build_zone_graph(Box(2, 1, 1), samples=0)
     mesh = trimesh.load(export_zone_mesh(g, tmp_path / "zones.ply"), process=False)
     assert len(mesh.vertices) == 3 * len(mesh.faces)  # three corners per triangle, none merged
-    assert mesh.volume == pytest.approx(float(np.prod(g.box[3:] - g.box[:3])), rel=1e-6)  # outward
+    assert mesh.volume == pytest.approx(2.0, rel=1e-6)  # the box's, in its own units; outward

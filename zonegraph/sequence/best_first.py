@@ -70,6 +70,7 @@ class SearchResult:
     trace: list[tuple[float, float]]  # (seconds, best IoU so far)
     proposals_per_state: list[int]
     expansion_s: list[float]  # seconds per expansion (proposals + scoring)
+    ended: str = "exhausted"  # why it stopped: exact, exhausted (its space), budget or expansions
 
 
 @dataclass
@@ -129,8 +130,13 @@ def search(
 
     stack = [_Frame(empty, [], expand(empty, []))]
     exact = bool(np.array_equal(empty, target))
+    ended = "exhausted"
     while stack and not exact:
-        if deadline.passed() or (config.max_expansions and len(counts) >= config.max_expansions):
+        if deadline.passed():
+            ended = "budget"
+            break
+        if config.max_expansions and len(counts) >= config.max_expansions:
+            ended = "expansions"
             break
         frame = stack[-1]
         child = next(frame.children, None)
@@ -164,4 +170,5 @@ def search(
         trace=trace,
         proposals_per_state=counts,
         expansion_s=times,
+        ended="exact" if exact else ended,
     )

@@ -99,8 +99,9 @@ def _solid_triangles(solid: object) -> np.ndarray:
 def export_zone_mesh(graph: ZoneGraph, path: str | Path) -> Path:
     """Write every zone as coloured triangles (inside: blue, outside: translucent grey).
 
-    The file is in the normalised frame, like the graph; PLY keeps per-face RGBA colours and
-    opens in MeshLab, Blender or any trimesh-based viewer.
+    The file is in the part's own coordinates and units (the graph's normalisation undone), so it
+    overlays the input in a viewer; PLY keeps per-face RGBA colours and opens in MeshLab, Blender
+    or any trimesh-based viewer.
 
     Raises:
         ValueError: the graph was loaded without its zone solids.
@@ -110,7 +111,7 @@ def export_zone_mesh(graph: ZoneGraph, path: str | Path) -> Path:
     BRepMesh_IncrementalMesh(make_compound(graph.solids), EXPORT_DEFLECTION, False, 0.5, False)
     corners, colours = [], []
     for solid, inside in zip(graph.solids, graph.zone_inside, strict=True):
-        c = _solid_triangles(solid)
+        c = graph.normalization.to_original(_solid_triangles(solid).reshape(-1, 3)).reshape(-1, 3, 3)
         corners.append(c)
         colours.append(np.tile(INSIDE_RGBA if inside else OUTSIDE_RGBA, (len(c), 1)))
     path = Path(path)
