@@ -115,3 +115,44 @@ def test_cli_build_errors_are_one_line(tmp_path, args, message):
     assert proc.returncode == 2
     lines = [line for line in proc.stderr.splitlines() if line.startswith("zonegraph:")]
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in proc.stderr
+
+
+def _saved_l_shape(tmp_path: Path) -> Path:
+    from build123d import Pos
+
+    part = Box(2, 1, 1) + Pos(0.5, 0.5, 0.5) * Box(1, 1, 1)
+    return save_zone_graph(build_zone_graph(list(part.solids()), samples=4), tmp_path / "g")
+
+
+def _garble(path: Path, offset: int, n: int = 64) -> None:
+    data = bytearray(path.read_bytes())
+    rng = np.random.default_rng(0)
+    at = min(offset, len(data) - n)
+    data[at : at + n] = rng.integers(0, 256, n, dtype=np.uint8).tobytes()
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize("name", ["zones.parquet", "faces.parquet", "links.parquet", "surfaces.parquet"])
+def test_garbled_or_truncated_tables_are_invalid_input(tmp_path, name):
+    """Bytes changed on disk are a clear bad-input error, never a bug or numbers read as garbage."""
+    folder = _saved_l_shape(tmp_path)
+    size = (folder / name).stat().st_size
+    for damage in ("truncate", "garble"):
+        original = (folder / name).read_bytes()
+        if damage == "truncate":
+            (folder / name).write_bytes(original[: size // 2])
+        else:
+            _garble(folder / name, 4)
+        with pytest.raises(InputError, match="corrupt zone graph"):
+            load_zone_graph(folder)
+        (folder / name).write_bytes(original)
+    assert load_zone_graph(folder).n_zones > 0
+
+
+def test_a_truncated_zones_brep_is_invalid_input(tmp_path):
+    folder = _saved_l_shape(tmp_path)
+    brep = folder / "zones.brep"
+    brep.write_bytes(brep.read_bytes()[: brep.stat().st_size // 2])
+    with pytest.raises(InputError, match="corrupt zone graph"):
+        load_zone_graph(folder)
+    assert load_zone_graph(folder, solids=False).n_zones > 0
