@@ -73,7 +73,9 @@ def generate(count: int, seed: int, dask_cfg: DaskParams, timeout: float, out: P
         path = str(json_dir / f"{name}.json")
         jobs.append(Job(name, fingerprint(code, s), (name, s, path), outputs=(path,)))
     with dask_client(dask_cfg) as client:
-        records = run_jobs(write_design, jobs, out / "records", client, timeout, "generate")
+        records = run_jobs(
+            write_design, jobs, out / "records", client, timeout, "generate", memory_mb=dask_cfg.memory_mb
+        )
     for r in records:
         if r["status"] != Status.OK:
             print(f"generate: {r['design_id']} failed ({r['status']}): {r['reason']}")
@@ -102,7 +104,15 @@ def convert_corpus(
         for e in entries
     ]
     with dask_client(dask_cfg) as client:  # each design in a child killed at its timeout
-        records = run_jobs(convert_to_json, jobs, out / "convert_records", client, timeout, "convert")
+        records = run_jobs(
+            convert_to_json,
+            jobs,
+            out / "convert_records",
+            client,
+            timeout,
+            "convert",
+            memory_mb=dask_cfg.memory_mb,
+        )
     table = records_frame(records, ("convert_status", "convert_reason", "folder"))
     table["folder"] = [e.folder for e in entries]
     failed = table["status"] != Status.OK  # the child timed out, crashed or met a bug of ours

@@ -76,9 +76,16 @@ def main() -> None:
                 inputs=(row.brep_dir, str(graph)),
             )
         )
-    with dask_client(section(DaskParams, "dask")) as client:
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
         records = run_jobs(
-            ground_truth_and_coverage, jobs, args.out / "records", client, cfg.timeout_s, "ground_truth"
+            ground_truth_and_coverage,
+            jobs,
+            args.out / "records",
+            client,
+            cfg.timeout_s,
+            "ground_truth",
+            memory_mb=dask.memory_mb,
         )
     steps = [dict(step, design_id=r["design_id"]) for r in records for step in r.get("steps", [])]
     args.out.mkdir(parents=True, exist_ok=True)

@@ -108,8 +108,11 @@ def main() -> None:
         for row in todo.itertuples()
         if row.design_id in gt_of
     ]
-    with dask_client(section(DaskParams, "dask")) as client:
-        records = run_jobs(label_and_save, jobs, out / "records", client, cfg.timeout_s, "labels")
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
+        records = run_jobs(
+            label_and_save, jobs, out / "records", client, cfg.timeout_s, "labels", memory_mb=dask.memory_mb
+        )
     keep = {r["design_id"] for r in records if r["status"] == Status.OK}
     for shard in [*out.glob("proposals/*.parquet"), *out.glob("steps/*.parquet")]:
         if shard.stem not in keep:  # a failed design or one of an earlier, different run

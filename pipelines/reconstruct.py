@@ -88,9 +88,16 @@ def main() -> None:
                     inputs=(brep, str(graph)),
                 )
             )
-    with dask_client(section(DaskParams, "dask")) as client:
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
         records = run_jobs(
-            reconstruct_design, jobs, args.out / "records", client, cfg.timeout_s, "reconstruct"
+            reconstruct_design,
+            jobs,
+            args.out / "records",
+            client,
+            cfg.timeout_s,
+            "reconstruct",
+            memory_mb=dask.memory_mb,
         )
     results = records_frame(records, ("exact", "iou_brep", "time_to_best_s"))
     if len(results):

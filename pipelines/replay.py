@@ -73,8 +73,17 @@ def main() -> None:
                 inputs=(design,),
             )
         )
-    with dask_client(section(DaskParams, "dask")) as client:
-        records = run_jobs(replay_design, jobs, args.out / "records", client, cfg.timeout_s, "replay")
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
+        records = run_jobs(
+            replay_design,
+            jobs,
+            args.out / "records",
+            client,
+            cfg.timeout_s,
+            "replay",
+            memory_mb=dask.memory_mb,
+        )
     manifest = records_frame(records, ("volume_rel_error", "brep_dir"))
     manifest["brep_dir"] = [str(args.out / "breps" / d) for d in manifest["design_id"]]  # where they are now
     manifest.insert(1, "split", index["split"].to_numpy())

@@ -50,8 +50,17 @@ def main() -> None:
                 inputs=(brep,),
             )
         )
-    with dask_client(section(DaskParams, "dask")) as client:
-        records = run_jobs(build_and_save, jobs, args.out / "records", client, cfg.timeout_s, "zonegraphs")
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
+        records = run_jobs(
+            build_and_save,
+            jobs,
+            args.out / "records",
+            client,
+            cfg.timeout_s,
+            "zonegraphs",
+            memory_mb=dask.memory_mb,
+        )
     built = records_frame(records, ("target_faces", "faces", "zones", "edges", "build_s"))
     skipped = replayed.loc[replayed["status"] != Status.OK, ["design_id", "status", "reason"]]
     manifest = pd.concat([built, skipped], ignore_index=True)

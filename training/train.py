@@ -20,7 +20,10 @@ import csv
 import hashlib
 import json
 import os
+import signal
+import socket
 import subprocess
+import threading
 import time
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -144,6 +147,34 @@ def split_designs(labels_dir: str | Path, seed: int, fraction: float) -> tuple[l
     return [i for i in ids if i not in val], sorted(val)
 
 
+def _terminated(signum: int, frame: Any) -> None:
+    raise SystemExit(f"training stopped by signal {signum}")  # mlflow's run context ends it FAILED
+
+
+def fail_dead_runs(experiment_id: str) -> None:
+    """End as FAILED the runs still RUNNING whose training process on this host is gone: a
+    ``kill -9`` (or a lost machine) leaves no chance to end them, so the next training does."""
+    import mlflow
+
+    client = mlflow.MlflowClient()
+    host = socket.gethostname()
+    for run in client.search_runs([experiment_id], "attributes.status = 'RUNNING'"):
+        tags = run.data.tags
+        pid = tags.get("zonegraph.pid", "")
+        if tags.get("zonegraph.host") == host and pid.isdigit() and not _alive(int(pid)):
+            client.set_terminated(run.info.run_id, status="FAILED")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 def train(config: TrainConfig) -> dict[str, Any]:
     """One training run; returns the best epoch's metrics (also in ``out_dir/metrics.json``)."""
     import mlflow  # a heavy import: only when training
@@ -175,9 +206,14 @@ def train(config: TrainConfig) -> dict[str, Any]:
     out = Path(config.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     mlflow.set_tracking_uri(os.environ.get("MLFLOW_TRACKING_URI", DEFAULT_TRACKING))
-    mlflow.set_experiment(config.experiment)
+    experiment = mlflow.set_experiment(config.experiment)
+    fail_dead_runs(experiment.experiment_id)
     curve, best = [], {"val_rank": float("inf")}
-    with mlflow.start_run() as run:
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminated)  # a killed training's run ends FAILED, not RUNNING
+    with mlflow.start_run(
+        tags={"zonegraph.host": socket.gethostname(), "zonegraph.pid": str(os.getpid())}
+    ) as run:
         sizes = {
             "train_designs": len(train_ids),
             "val_designs": len(val_ids),

@@ -79,9 +79,19 @@ def _die_with_parent(parent: int) -> None:
 
 
 def _limit_memory(memory_mb: int | None) -> None:
+    """Allow ``memory_mb`` MiB of address space beyond what the child inherited: a parent that
+    imported torch maps many GiB it never touches, which an absolute limit would count."""
     if memory_mb:
-        limit = int(memory_mb) << 20
+        with open("/proc/self/statm") as f:
+            inherited = int(f.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+        limit = inherited + (int(memory_mb) << 20)
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+
+
+def default_memory_mb() -> int | None:
+    """The memory limit of children when the caller names none: ``$ZONEGRAPH_MEMORY_MB`` (MiB)."""
+    value = os.environ.get("ZONEGRAPH_MEMORY_MB", "")
+    return int(value) if value.isdigit() and int(value) > 0 else None
 
 
 def _child(
@@ -108,9 +118,11 @@ def _child(
 def run_isolated(
     fn: Callable, args: tuple = (), timeout: float | None = 60.0, memory_mb: int | None = None
 ) -> Outcome:
-    """``fn(*args)`` in a forked child under ``memory_mb`` MiB of address space (None: no limit);
+    """``fn(*args)`` in a forked child allowed ``memory_mb`` more MiB of address space (None:
+    :func:`default_memory_mb`);
     its return value must be picklable (keep it small). ``timeout`` None runs in-process (no limit
     of either kind)."""
+    memory_mb = memory_mb or default_memory_mb()
     if timeout is None and not memory_mb:
         return _run_inline(fn, args)
     ctx = mp.get_context("fork")
