@@ -145,13 +145,16 @@ def _one_line(exc: BaseException) -> str:
 
 def _inconsistency(graph: ZoneGraph) -> str | None:
     """What in a read graph cannot come from :func:`save_zone_graph`, or None: non-finite or
-    negative measures, indices out of range, a zone solid per zone missing."""
-    measures = {
+    negative measures (normals and offsets are NaN off planes), indices out of range, a zone
+    solid per zone missing."""
+    measures = {  # always finite
         "zone volumes": graph.zone_volume,
         "zone centroids": graph.zone_centroid,
         "zone boxes": graph.zone_bbox,
         "face areas": graph.face_area,
         "face centroids": graph.face_centroid,
+    }
+    planar = {  # NaN where the face or surface is not a plane
         "face normals": graph.face_normal,
         "surface offsets": graph.surface_offset,
         "surface normals": graph.surface_normal,
@@ -159,6 +162,9 @@ def _inconsistency(graph: ZoneGraph) -> str | None:
     for name, values in measures.items():
         if not np.isfinite(values).all() or (np.abs(values) > 1e6).any():
             return f"{name} not finite or out of range"
+    for name, values in planar.items():
+        if np.isinf(values).any() or (np.abs(np.nan_to_num(values)) > 1e6).any():
+            return f"{name} out of range"
     if (graph.zone_volume < 0).any() or (graph.face_area < 0).any():
         return "negative zone volume or face area"
     n_zones, n_faces, n_surfaces = graph.n_zones, len(graph.face_area), len(graph.surface_offset)
