@@ -9,6 +9,7 @@ interrupted evaluation resumes and a second run does nothing.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import multiprocessing
@@ -20,6 +21,7 @@ from typing import Any
 
 import pandas as pd
 
+import zonegraph
 from zonegraph.configs import InferConfig
 from zonegraph.isolation import run_isolated
 from zonegraph.reconstruction import infer
@@ -52,12 +54,39 @@ class Search:
         return f"{self.name.replace(':', '_')}_k{self.config.k}/{self.target.design_id}"
 
     def fingerprint(self) -> str:
-        """The settings and the model's bytes; not the model's path, so a moved project resumes."""
+        """The settings, the model's bytes, the target's and its saved graph's bytes and the code
+        that searches: a record made of another target, graph or code is searched again. Paths
+        are left out, so a moved project resumes."""
         model = Path(self.config.model) if self.config.model else None
-        weights = model.read_bytes() if model and model.is_file() else b""
         config = {**asdict(self.config), "model": bool(model)}
-        settings = json.dumps([config, asdict(self.target)], sort_keys=True, default=str)
-        return hashlib.sha1(settings.encode() + weights).hexdigest()
+        target = {
+            **asdict(self.target),
+            "path": Path(self.target.path).name,
+            "graph": bool(self.target.graph),
+        }
+        h = hashlib.sha1(json.dumps([config, target], sort_keys=True, default=str).encode())
+        for path in (model, Path(self.target.path), Path(self.target.graph) if self.target.graph else None):
+            if path is not None:
+                h.update(_tree_hash(path).encode())
+        h.update(_code_hash().encode())
+        return h.hexdigest()
+
+
+def _tree_hash(path: Path, pattern: str = "*") -> str:
+    """A file's bytes, or every file of a folder matching ``pattern`` with its relative name;
+    the hash of nothing when absent."""
+    h = hashlib.sha1()
+    files = [path] if path.is_file() else sorted(f for f in path.rglob(pattern) if f.is_file())
+    for f in files:
+        h.update(str(f.relative_to(path)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+@functools.cache
+def _code_hash() -> str:
+    """The source of the package that searches (``zonegraph``), hashed once per process."""
+    return _tree_hash(Path(zonegraph.__file__).parent, "*.py")
 
 
 def split_targets(split: str, root: str | Path = ".") -> list[Target]:
@@ -112,10 +141,12 @@ def _run_one(search: Search, records: Path, timeout_s: float) -> dict[str, Any]:
     """One search's record: reused when made with the same settings, else searched and written."""
     path = records / f"{search.key}.json"
     fingerprint = search.fingerprint()
-    if path.is_file():
+    try:
         record = json.loads(path.read_text())
-        if record.get("fingerprint") == fingerprint:
-            return record
+    except (OSError, ValueError):  # absent, or truncated by a killed run: searched again
+        record = None
+    if isinstance(record, dict) and record.get("fingerprint") == fingerprint:
+        return record
     out = records / "programs" / search.key
     outcome = run_isolated(
         _search, (search.target.path, search.target.graph, search.config, str(out)), timeout_s

@@ -30,7 +30,7 @@ from zonegraph.status import Status
 from .cluster import dask_client
 from .params import PARAMS_FILE, DaskParams, DataParams, SyntheticParams, section
 from .paths import stage_paths
-from .runner import Job, code_fingerprint, fingerprint, run_jobs
+from .runner import Job, code_fingerprint, fingerprint, records_frame, run_jobs
 
 
 def write_design(design_id: str, seed: int, path: str) -> dict[str, Any]:
@@ -70,9 +70,12 @@ def generate(count: int, seed: int, dask_cfg: DaskParams, timeout: float, out: P
     jobs = []
     for i in range(count):
         name, s = synthetic_id(i), design_seed(seed, i)
-        jobs.append(Job(name, fingerprint(code, s), (name, s, str(json_dir / f"{name}.json"))))
+        path = str(json_dir / f"{name}.json")
+        jobs.append(Job(name, fingerprint(code, s), (name, s, path), outputs=(path,)))
     with dask_client(dask_cfg) as client:
-        records = run_jobs(write_design, jobs, out / "records", client, timeout, "generate")
+        records = run_jobs(
+            write_design, jobs, out / "records", client, timeout, "generate", memory_mb=dask_cfg.memory_mb
+        )
     for r in records:
         if r["status"] != Status.OK:
             print(f"generate: {r['design_id']} failed ({r['status']}): {r['reason']}")
@@ -93,13 +96,24 @@ def convert_corpus(
         Job(
             e.design_id,
             fingerprint(code, timeout, files=(e.batch,)),
-            (e.batch, e.design_id, str(json_dir / f"{e.design_id}.json")),
+            (str(e.batch), e.design_id, str(json_dir / f"{e.design_id}.json")),
+            outputs=(str(json_dir / f"{e.design_id}.json"),),
+            inputs=(str(e.batch),),
+            outputs_optional=True,  # a design that does not convert writes no JSON
         )
         for e in entries
     ]
     with dask_client(dask_cfg) as client:  # each design in a child killed at its timeout
-        records = run_jobs(convert_to_json, jobs, out / "convert_records", client, timeout, "convert")
-    table = pd.DataFrame(records).drop(columns=["fingerprint"])
+        records = run_jobs(
+            convert_to_json,
+            jobs,
+            out / "convert_records",
+            client,
+            timeout,
+            "convert",
+            memory_mb=dask_cfg.memory_mb,
+        )
+    table = records_frame(records, ("convert_status", "convert_reason", "folder"))
     table["folder"] = [e.folder for e in entries]
     failed = table["status"] != Status.OK  # the child timed out, crashed or met a bug of ours
     table.loc[failed, "convert_status"] = table.loc[failed, "status"]

@@ -24,7 +24,7 @@ from zonegraph.status import Status
 from .cluster import dask_client
 from .params import DaskParams, GroundTruthParams, section
 from .paths import stage_paths
-from .runner import Job, code_fingerprint, fingerprint, run_jobs
+from .runner import Job, code_fingerprint, fingerprint, records_frame, run_jobs
 
 
 def designs_table(designs: Path, replayed: Path, zonegraphs: Path) -> pd.DataFrame:
@@ -73,25 +73,31 @@ def main() -> None:
                 fingerprint(code, settings, ops, files=(row.brep_dir, graph)),
                 (row.brep_dir, str(graph), ops, *settings),
                 cost=float(row.graph_zones),
+                inputs=(row.brep_dir, str(graph)),
             )
         )
-    with dask_client(section(DaskParams, "dask")) as client:
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
         records = run_jobs(
-            ground_truth_and_coverage, jobs, args.out / "records", client, cfg.timeout_s, "ground_truth"
+            ground_truth_and_coverage,
+            jobs,
+            args.out / "records",
+            client,
+            cfg.timeout_s,
+            "ground_truth",
+            memory_mb=dask.memory_mb,
         )
     steps = [dict(step, design_id=r["design_id"]) for r in records for step in r.get("steps", [])]
     args.out.mkdir(parents=True, exist_ok=True)
     pd.DataFrame(steps).to_parquet(args.out / "steps.parquet", index=False)
-    results = pd.DataFrame([{k: v for k, v in r.items() if k != "steps"} for r in records])
+    results = records_frame([{k: v for k, v in r.items() if k != "steps"} for r in records])
     failed = results["status"] != Status.OK  # the whole job timed out or crashed
     for graph in ("simplified", "full"):
         column = f"{graph}_status"
         if column not in results:
             results[column] = None
         results.loc[failed, column] = results.loc[failed, "status"]
-    results = results.drop(columns=["status", "reason", "fingerprint"]).rename(
-        columns={"seconds": "gt_seconds"}
-    )
+    results = results.drop(columns=["status", "reason"]).rename(columns={"seconds": "gt_seconds"})
     designs = table.merge(results, on="design_id", how="left")
     designs.to_parquet(args.out / "designs.parquet", index=False)
     write_coverage(designs, levels, args.out, args.plot, args.metrics)

@@ -24,7 +24,8 @@ from zonegraph.status import Status
 from .cluster import dask_client
 from .params import DaskParams, LabelsParams, section
 from .paths import stage_paths
-from .runner import Job, code_fingerprint, fingerprint, run_jobs
+from .records import retry_summary
+from .runner import Job, code_fingerprint, fingerprint, records_frame, run_jobs
 
 
 def saved_graph_rows(steps: pd.DataFrame) -> pd.DataFrame:
@@ -98,20 +99,28 @@ def main() -> None:
                 *settings(row.split),
             ),
             cost=float(row.graph_zones),
+            outputs=(
+                str(out / "proposals" / f"{row.design_id}.parquet"),
+                str(out / "steps" / f"{row.design_id}.parquet"),
+            ),
+            inputs=(str(graphs / row.design_id),),
         )
         for row in todo.itertuples()
         if row.design_id in gt_of
     ]
-    with dask_client(section(DaskParams, "dask")) as client:
-        records = run_jobs(label_and_save, jobs, out / "records", client, cfg.timeout_s, "labels")
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
+        records = run_jobs(
+            label_and_save, jobs, out / "records", client, cfg.timeout_s, "labels", memory_mb=dask.memory_mb
+        )
     keep = {r["design_id"] for r in records if r["status"] == Status.OK}
     for shard in [*out.glob("proposals/*.parquet"), *out.glob("steps/*.parquet")]:
         if shard.stem not in keep:  # a failed design or one of an earlier, different run
             shard.unlink()
     split_of = dict(zip(todo["design_id"], todo["split"], strict=True))
-    table = pd.DataFrame(records)
+    table = records_frame(records)
     ranked = table["design_id"].map(split_of).isin(rank_splits) if len(table) else pd.Series(dtype=bool)
-    metrics = {**count(table[~ranked]), "rank_only": count(table[ranked])}
+    metrics = {**count(table[~ranked]), "rank_only": count(table[ranked]), "runner": retry_summary(records)}
     args.metrics.parent.mkdir(parents=True, exist_ok=True)
     args.metrics.write_text(json.dumps(metrics, indent=2))
     print(

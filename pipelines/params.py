@@ -74,10 +74,13 @@ class DaskParams(Config):
     Args:
         scheduler: address of an existing cluster (None: a local one).
         n_workers: workers of the local cluster.
+        memory_mb: address space each design's child may add in MiB (None: no limit); past it a
+            design is ``out_of_memory``. A worker's own memory monitor does not see its children.
     """
 
     scheduler: str | None = None
     n_workers: int = 2
+    memory_mb: int | None = None
 
 
 @dataclass(frozen=True)

@@ -21,10 +21,14 @@ UPSTREAM = {  # the folders stages read, by the name of their flag
 
 def stage_paths(doc: str, inputs: tuple[str, ...], **outputs: str) -> argparse.Namespace:
     """Parse a stage's command line: the upstream folders ``inputs`` (names of :data:`UPSTREAM`)
-    and its ``outputs`` (flag name -> what it is), all required paths."""
+    and its ``outputs`` (flag name -> what it is), all required paths, made absolute: job paths
+    built from them name the same files on a Dask worker started in any folder."""
     parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     for name in inputs:
         parser.add_argument(f"--{name}", type=Path, required=True, help=UPSTREAM[name])
     for name, what in outputs.items():
         parser.add_argument(f"--{name}", type=Path, required=True, help=what)
-    return parser.parse_args()
+    args = parser.parse_args()
+    for name in (*inputs, *outputs):
+        setattr(args, name, getattr(args, name).resolve())
+    return args

@@ -23,7 +23,7 @@ from zonegraph.status import Status
 from .cluster import dask_client
 from .params import DaskParams, ReconstructParams, section
 from .paths import stage_paths
-from .runner import Job, code_fingerprint, fingerprint, run_jobs
+from .runner import Job, code_fingerprint, fingerprint, records_frame, run_jobs
 
 SEARCHED = (Status.EXACT, Status.PARTIAL, Status.REBUILD_FAILED)  # a search ran and gave a program
 
@@ -64,7 +64,11 @@ def main() -> None:
     cfg = section(ReconstructParams, "reconstruct")
     replayed = pd.read_parquet(args.replay / "manifest.parquet")
     test = replayed[(replayed["split"] == "test") & (replayed["status"] == Status.OK)]
-    zones = pd.read_parquet(args.zonegraphs / "manifest.parquet").set_index("design_id")["zones"].fillna(0)
+    graphs = pd.read_parquet(args.zonegraphs / "manifest.parquet").set_index("design_id")
+    built = test["design_id"].isin(graphs.index[graphs["status"] == Status.OK])
+    unbuilt = graphs.loc[test.loc[~built, "design_id"], ["status", "reason"]].reset_index()
+    test = test[built]  # a graph folder the current zonegraphs run did not build is stale: never searched
+    zones = graphs["zones"].fillna(0)
     code = code_fingerprint("reconstruct")
     jobs = []
     for guide in cfg.guides:
@@ -73,20 +77,35 @@ def main() -> None:
         for row in test.itertuples():
             brep = f"{row.brep_dir}/final.brep"
             graph = args.zonegraphs / "graphs" / row.design_id
+            out = str(args.out / guide / row.design_id)
             jobs.append(
                 Job(
                     f"{guide}__{row.design_id}",
                     fingerprint(code, repr(config), files=(brep, graph, *model)),
-                    (brep, str(args.out / guide / row.design_id), config, str(graph)),
+                    (brep, out, config, str(graph)),
                     cost=float(zones.get(row.design_id, 0)),
+                    outputs=(out,),
+                    inputs=(brep, str(graph)),
                 )
             )
-    with dask_client(section(DaskParams, "dask")) as client:
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
         records = run_jobs(
-            reconstruct_design, jobs, args.out / "records", client, cfg.timeout_s, "reconstruct"
+            reconstruct_design,
+            jobs,
+            args.out / "records",
+            client,
+            cfg.timeout_s,
+            "reconstruct",
+            memory_mb=dask.memory_mb,
         )
-    results = pd.DataFrame(records).drop(columns=["fingerprint"])
-    results[["guide", "design_id"]] = results["design_id"].str.split("__", n=1, expand=True)
+    results = records_frame(records, ("exact", "iou_brep", "time_to_best_s"))
+    if len(results):
+        results[["guide", "design_id"]] = results["design_id"].str.split("__", n=1, expand=True)
+    else:
+        results["guide"] = None
+    skipped = [unbuilt.assign(guide=guide) for guide in cfg.guides if len(unbuilt)]
+    results = pd.concat([results, *skipped], ignore_index=True)
     results.to_parquet(args.out / "results.parquet", index=False)
     metrics = summarise(results)
     args.metrics.parent.mkdir(parents=True, exist_ok=True)

@@ -21,7 +21,8 @@ from zonegraph.verified import REPLAY_RTOL
 from .cluster import dask_client
 from .params import DaskParams, ReplayParams, section
 from .paths import stage_paths
-from .runner import Job, code_fingerprint, fingerprint, run_jobs
+from .records import retry_summary
+from .runner import Job, code_fingerprint, fingerprint, records_frame, run_jobs
 
 
 def replay_design(path: str, out_dir: str) -> dict:
@@ -60,17 +61,31 @@ def main() -> None:
     cfg = section(ReplayParams, "replay")
     index = pd.read_parquet(args.designs / "index.parquet")
     code = code_fingerprint("replay")
-    jobs = [
-        Job(
-            row.design_id,
-            fingerprint(code, files=(row.path,)),
-            (row.path, str(args.out / "breps" / row.design_id)),
+    jobs = []
+    for row in index.itertuples():
+        design, breps = str(Path(row.path).resolve()), str(args.out / "breps" / row.design_id)
+        jobs.append(
+            Job(
+                row.design_id,
+                fingerprint(code, files=(design,)),
+                (design, breps),
+                outputs=(breps,),
+                inputs=(design,),
+            )
         )
-        for row in index.itertuples()
-    ]
-    with dask_client(section(DaskParams, "dask")) as client:
-        records = run_jobs(replay_design, jobs, args.out / "records", client, cfg.timeout_s, "replay")
-    manifest = pd.DataFrame(records).drop(columns=["fingerprint"])
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
+        records = run_jobs(
+            replay_design,
+            jobs,
+            args.out / "records",
+            client,
+            cfg.timeout_s,
+            "replay",
+            memory_mb=dask.memory_mb,
+        )
+    manifest = records_frame(records, ("volume_rel_error", "brep_dir"))
+    manifest["brep_dir"] = [str(args.out / "breps" / d) for d in manifest["design_id"]]  # where they are now
     manifest.insert(1, "split", index["split"].to_numpy())
     manifest.to_parquet(args.out / "manifest.parquet", index=False)
     ok = manifest["status"] == Status.OK
@@ -80,6 +95,7 @@ def main() -> None:
         "failed": {k: int(v) for k, v in manifest.loc[~ok, "status"].value_counts().items()},
         "median_seconds": float(np.median(manifest["seconds"])) if len(manifest) else 0.0,
         "max_volume_rel_error": float(manifest.loc[ok, "volume_rel_error"].max()) if ok.any() else None,
+        "runner": retry_summary(records),
     }
     args.metrics.parent.mkdir(parents=True, exist_ok=True)
     args.metrics.write_text(json.dumps(metrics, indent=2))

@@ -21,7 +21,8 @@ from zonegraph.status import Status
 from .cluster import dask_client
 from .params import DaskParams, ZoneGraphParams, section
 from .paths import stage_paths
-from .runner import Job, code_fingerprint, fingerprint, run_jobs
+from .records import retry_summary
+from .runner import Job, code_fingerprint, fingerprint, records_frame, run_jobs
 
 
 def main() -> None:
@@ -36,18 +37,31 @@ def main() -> None:
     ok = replayed[replayed["status"] == Status.OK]
     code = code_fingerprint("zonegraphs")
     config = BuildConfig.from_mapping(asdict(cfg))  # the section less the stage's timeout
-    jobs = [
-        Job(
-            row.design_id,
-            fingerprint(code, repr(config), files=(f"{row.brep_dir}/final.brep",)),
-            (f"{row.brep_dir}/final.brep", str(args.out / "graphs" / row.design_id), config),
-            cost=row.faces,
+    jobs = []
+    for row in ok.itertuples():
+        brep, graph = f"{row.brep_dir}/final.brep", str(args.out / "graphs" / row.design_id)
+        jobs.append(
+            Job(
+                row.design_id,
+                fingerprint(code, repr(config), files=(brep,)),
+                (brep, graph, config),
+                cost=row.faces,
+                outputs=(graph,),
+                inputs=(brep,),
+            )
         )
-        for row in ok.itertuples()
-    ]
-    with dask_client(section(DaskParams, "dask")) as client:
-        records = run_jobs(build_and_save, jobs, args.out / "records", client, cfg.timeout_s, "zonegraphs")
-    built = pd.DataFrame(records).drop(columns=["fingerprint"])
+    dask = section(DaskParams, "dask")
+    with dask_client(dask) as client:
+        records = run_jobs(
+            build_and_save,
+            jobs,
+            args.out / "records",
+            client,
+            cfg.timeout_s,
+            "zonegraphs",
+            memory_mb=dask.memory_mb,
+        )
+    built = records_frame(records, ("target_faces", "faces", "zones", "edges", "build_s"))
     skipped = replayed.loc[replayed["status"] != Status.OK, ["design_id", "status", "reason"]]
     manifest = pd.concat([built, skipped], ignore_index=True)
     manifest = manifest.merge(replayed[["design_id", "split"]], on="design_id")
@@ -56,12 +70,12 @@ def main() -> None:
     )
     manifest["simplified"] = config.simplify
     manifest.to_parquet(args.out / "manifest.parquet", index=False)
-    write_metrics(manifest, args.metrics)
+    write_metrics(manifest, args.metrics, retry_summary(records))
 
 
-def write_metrics(manifest: pd.DataFrame, metrics_file: Path) -> None:
+def write_metrics(manifest: pd.DataFrame, metrics_file: Path, retries: dict | None = None) -> None:
     ok = manifest["status"] == Status.OK
-    build = manifest.loc[ok, "build_s"].to_numpy(float)
+    build = manifest.loc[ok, "build_s"].to_numpy(float) if "build_s" in manifest else np.zeros(0)
     metrics = {
         "designs": int(len(manifest)),
         "ok": int(ok.sum()),
@@ -69,6 +83,7 @@ def write_metrics(manifest: pd.DataFrame, metrics_file: Path) -> None:
         "median_build_s": float(np.median(build)) if len(build) else None,
         "p90_build_s": float(np.percentile(build, 90)) if len(build) else None,
         "median_zones": float(manifest.loc[ok, "zones"].median()) if ok.any() else None,
+        "runner": retries or {},
     }
     metrics_file.parent.mkdir(parents=True, exist_ok=True)
     metrics_file.write_text(json.dumps(metrics, indent=2))

@@ -28,7 +28,10 @@ import csv
 import hashlib
 import json
 import os
+import signal
+import socket
 import subprocess
+import threading
 import time
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -232,6 +235,34 @@ def datasets(config: TrainConfig, train_ids: list[str], val_ids: list[str]) -> d
     return sets
 
 
+def _terminated(signum: int, frame: Any) -> None:
+    raise SystemExit(f"training stopped by signal {signum}")  # mlflow's run context ends it FAILED
+
+
+def fail_dead_runs(experiment_id: str) -> None:
+    """End as FAILED the runs still RUNNING whose training process on this host is gone: a
+    ``kill -9`` (or a lost machine) leaves no chance to end them, so the next training does."""
+    import mlflow
+
+    client = mlflow.MlflowClient()
+    host = socket.gethostname()
+    for run in client.search_runs([experiment_id], "attributes.status = 'RUNNING'"):
+        tags = run.data.tags
+        pid = tags.get("zonegraph.pid", "")
+        if tags.get("zonegraph.host") == host and pid.isdigit() and not _alive(int(pid)):
+            client.set_terminated(run.info.run_id, status="FAILED")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     """One training run, or the rest of an interrupted one; returns the best epoch's metrics
     (also in ``out_dir/metrics.json``)."""
@@ -269,8 +300,12 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
         curve, best, first = last["curve"], last["best"], last["epoch"] + 1
         print(f"train: resuming at epoch {first} of {config.epochs}, MLflow run {last['run_id']}", flush=True)
     mlflow.set_tracking_uri(os.environ.get("MLFLOW_TRACKING_URI", DEFAULT_TRACKING))
-    mlflow.set_experiment(config.experiment)
-    with mlflow.start_run(run_id=last["run_id"] if last else None) as run:
+    experiment = mlflow.set_experiment(config.experiment)
+    fail_dead_runs(experiment.experiment_id)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminated)  # a killed training's run ends FAILED, not RUNNING
+    tags = {"zonegraph.host": socket.gethostname(), "zonegraph.pid": str(os.getpid())}
+    with mlflow.start_run(run_id=last["run_id"] if last else None, tags=tags) as run:
         sizes = {
             "train_designs": len(train_ids),
             "val_designs": len(val_ids),

@@ -3,13 +3,23 @@
 OpenCASCADE's STEP reader, Booleans and general fuse occasionally loop forever or segfault on bad
 geometry. Threads cannot be stopped, so each job runs in a forked process (cheap: the parent has
 already imported OCP) that is killed at its deadline. The outcome is a status, never an exception.
+
+A child must not outlive the process that waits for it (a killed ``infer`` or a lost Dask worker
+left its design computing for minutes, outside every timeout): on Linux it asks the kernel for
+SIGKILL when its parent dies (``PR_SET_PDEATHSIG``). It may also run under an address-space limit
+(``RLIMIT_AS``), since a worker's memory monitor does not see its forked children; an allocation
+past the limit is the ``out_of_memory`` status.
 """
 
 from __future__ import annotations
 
+import ctypes
 import gc
 import multiprocessing as mp
 import os
+import resource
+import signal
+import sys
 import time
 import traceback
 from collections.abc import Callable
@@ -44,6 +54,8 @@ def classify(exc: BaseException) -> tuple[Status, str, str]:
     of ours and keeps its traceback."""
     if isinstance(exc, ZoneGraphError):
         return exc.status, exc.explain(), ""
+    if isinstance(exc, MemoryError) or "OutOfMemory" in type(exc).__name__:
+        return Status.OUT_OF_MEMORY, f"out of memory ({type(exc).__name__}) under the job's memory limit", ""
     last = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
     where = f" ({os.path.basename(last.filename)}:{last.lineno} {last.name})" if last else ""
     name = type(exc).__name__
@@ -53,11 +65,46 @@ def classify(exc: BaseException) -> tuple[Status, str, str]:
     return Status.BUG, f"{name}: {message}{where}", "".join(traceback.format_exception(exc))
 
 
-def _child(conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
+
+
+def _die_with_parent(parent: int) -> None:
+    """Ask for SIGKILL when the parent dies; if it died before the request took effect, die now."""
+    if not sys.platform.startswith("linux"):
+        return
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent:
+        os._exit(1)
+
+
+def _limit_memory(memory_mb: int | None) -> None:
+    """Allow ``memory_mb`` MiB of address space beyond what the child inherited: a parent that
+    imported torch maps many GiB it never touches, which an absolute limit would count."""
+    if memory_mb:
+        with open("/proc/self/statm") as f:
+            inherited = int(f.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+        limit = inherited + (int(memory_mb) << 20)
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+
+
+def default_memory_mb() -> int | None:
+    """The memory limit of children when the caller names none: ``$ZONEGRAPH_MEMORY_MB`` (MiB)."""
+    value = os.environ.get("ZONEGRAPH_MEMORY_MB", "")
+    return int(value) if value.isdigit() and int(value) > 0 else None
+
+
+def _child(
+    conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...], parent: int, memory_mb: int | None
+) -> None:
     """Run the job with its console output captured: OpenCASCADE prints messages such as
     ``**** ERR StepFile`` from C++ straight to file descriptor 1, and numpy's warnings go to 2;
-    neither belongs on the user's terminal."""
+    neither belongs on the user's terminal. ``sys.exit`` inside the job is an outcome like any
+    exception (``SystemExit`` is caught below); ``os._exit`` and signals end the child without a
+    message, which the parent reports as a crash."""
+    _die_with_parent(parent)
     try:
+        _limit_memory(memory_mb)
         with captured():
             conn.send((Status.OK, fn(*args), "", ""))
     except BaseException as exc:  # noqa: BLE001 - every outcome, bugs included, goes to the parent
@@ -68,13 +115,19 @@ def _child(conn: Connection, fn: Callable[..., Any], args: tuple[Any, ...]) -> N
         os._exit(0)
 
 
-def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -> Outcome:
-    """``fn(*args)`` in a forked child; its return value must be picklable (keep it small)."""
-    if timeout is None:
+def run_isolated(
+    fn: Callable, args: tuple = (), timeout: float | None = 60.0, memory_mb: int | None = None
+) -> Outcome:
+    """``fn(*args)`` in a forked child allowed ``memory_mb`` more MiB of address space (None:
+    :func:`default_memory_mb`);
+    its return value must be picklable (keep it small). ``timeout`` None runs in-process (no limit
+    of either kind)."""
+    memory_mb = memory_mb or default_memory_mb()
+    if timeout is None and not memory_mb:
         return _run_inline(fn, args)
     ctx = mp.get_context("fork")
     recv, send = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child, args=(send, fn, args))
+    proc = ctx.Process(target=_child, args=(send, fn, args, os.getpid(), memory_mb))
     t0 = time.perf_counter()
     _fork(proc)
     send.close()
@@ -87,9 +140,7 @@ def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -
         status, value, reason, detail = recv.recv()
     except EOFError:
         proc.join()
-        return Outcome(
-            Status.CRASH, reason=f"worker died (exit code {proc.exitcode})", seconds=time.perf_counter() - t0
-        )
+        return _died(proc.exitcode, memory_mb, time.perf_counter() - t0)
     finally:
         recv.close()
         proc.join(5)
@@ -97,6 +148,21 @@ def run_isolated(fn: Callable, args: tuple = (), timeout: float | None = 60.0) -
             proc.kill()
             proc.join()
     return Outcome(status, value, reason, time.perf_counter() - t0, detail)
+
+
+def _died(exitcode: int | None, memory_mb: int | None, seconds: float) -> Outcome:
+    """A child that ended without a result: by a signal, ``os._exit`` or a failed C++ allocation
+    (which aborts, SIGABRT, when an address-space limit refused it)."""
+    if memory_mb and exitcode == -signal.SIGABRT:
+        return Outcome(
+            Status.OUT_OF_MEMORY, reason=f"aborted under the {memory_mb} MiB memory limit", seconds=seconds
+        )
+    if exitcode is not None and exitcode < 0:
+        name = signal.Signals(-exitcode).name if -exitcode in signal.valid_signals() else str(-exitcode)
+        reason = f"worker died (exit code {exitcode}, {name})"
+    else:
+        reason = f"worker exited without a result (exit code {exitcode})"
+    return Outcome(Status.CRASH, reason=reason, seconds=seconds)
 
 
 def _fork(proc: BaseProcess) -> None:

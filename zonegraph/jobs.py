@@ -184,7 +184,7 @@ def label_and_save(
     for name, table in (("proposals", proposals), ("steps", step_rows)):
         folder = Path(out_dir) / name
         folder.mkdir(parents=True, exist_ok=True)
-        tmp = folder / f"{design_id}.parquet.tmp"
+        tmp = folder / f".{design_id}.parquet.tmp"  # hidden: pyarrow.dataset never reads it
         pq.write_table(table, tmp)
         tmp.replace(folder / f"{design_id}.parquet")
     labels = np.asarray(proposals.column("label").to_pylist(), dtype=int)

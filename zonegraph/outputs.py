@@ -7,17 +7,24 @@ stayed as if it were current. Now each completed run lists what it wrote in :dat
 next run into the same folder first removes exactly those entries (never a file it did not write),
 so after a failure the folder holds nothing that looks current, and after a success only the new
 run's files.
+
+One run writes into an ``--out`` at a time: a second one finds its lock (``.OUT.lock`` beside it,
+an ``flock`` the kernel drops when the holder dies) and refuses in one line, instead of two runs
+mixing their files. Whoever holds the lock also removes the scratch folders that killed runs left.
 """
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
+from zonegraph.errors import ZoneGraphError
 from zonegraph.isolation import Outcome
 
 LISTING = ".zonegraph-outputs.json"
@@ -28,15 +35,36 @@ def run_staged(run: Callable[[Path], Outcome], out: Path) -> Outcome:
     scratch folder and the outputs of the previous run into ``out`` are removed."""
     out = Path(os.path.abspath(out))
     out.parent.mkdir(parents=True, exist_ok=True)
-    scratch = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
-    try:
-        outcome = run(scratch)
-        _remove_listed(out)
-        if outcome.ok:
-            _move_into(scratch, out)
-        return outcome
-    finally:
-        shutil.rmtree(scratch, ignore_errors=True)
+    with writer_lock(out):
+        for stale in out.parent.glob(f".{out.name}.partial-*"):  # of runs that were killed
+            shutil.rmtree(stale, ignore_errors=True)
+        scratch = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+        try:
+            outcome = run(scratch)
+            _remove_listed(out)
+            if outcome.ok:
+                _move_into(scratch, out)
+            return outcome
+        finally:
+            shutil.rmtree(scratch, ignore_errors=True)
+
+
+@contextmanager
+def writer_lock(out: Path) -> Iterator[None]:
+    """Hold ``out``'s lock for the block.
+
+    Raises:
+        ZoneGraphError: another run holds it (``invalid_input``: the command's input is the folder)."""
+    path = out.parent / f".{out.name}.lock"
+    with open(path, "a") as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise ZoneGraphError(str(out), "another zonegraph run is writing this folder") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def _remove_listed(out: Path) -> None:
@@ -71,6 +99,11 @@ def _remove(path: Path) -> None:
 def write_record(out: Path, name: str, text: str) -> None:
     """Write one file into ``out`` as the whole output of a run (a failed part's ``error.json``),
     listed so that the next run replaces it like any other output."""
+    with writer_lock(Path(os.path.abspath(out))):
+        _write_record(out, name, text)
+
+
+def _write_record(out: Path, name: str, text: str) -> None:
     _remove_listed(out)
     out.mkdir(parents=True, exist_ok=True)
     (out / name).write_text(text)

@@ -44,6 +44,8 @@ class Status(str, enum.Enum):
     # the environment's fault
     TIMEOUT = "timeout"
     CRASH = "crash"  # the process died (a signal, a lost worker)
+    OUT_OF_MEMORY = "out_of_memory"  # the job passed its memory limit (params.yaml / --memory)
+    WORKER_ERROR = "worker_error"  # the worker could not run it (an input missing there, daemonic)
 
     # ours
     BUG = "bug"  # an exception of our own code: its traceback is kept

@@ -142,3 +142,44 @@ def test_component_count_joins_edges_in_any_order():
 
     assert component_count(5, np.array([[3, 4], [0, 1], [4, 1]])) == 2  # {0, 1, 3, 4} and {2}
     assert component_count(3, np.zeros((0, 2), int)) == 3
+
+
+def _saved_l_shape(tmp_path: Path) -> Path:
+    from build123d import Pos
+
+    part = Box(2, 1, 1) + Pos(0.5, 0.5, 0.5) * Box(1, 1, 1)
+    return save_zone_graph(build_zone_graph(list(part.solids()), samples=4), tmp_path / "g")
+
+
+def _garble(path: Path, offset: int, n: int = 64) -> None:
+    data = bytearray(path.read_bytes())
+    rng = np.random.default_rng(0)
+    at = min(offset, len(data) - n)
+    data[at : at + n] = rng.integers(0, 256, n, dtype=np.uint8).tobytes()
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize("name", ["zones.parquet", "faces.parquet", "links.parquet", "surfaces.parquet"])
+def test_garbled_or_truncated_tables_are_invalid_input(tmp_path, name):
+    """Bytes changed on disk are a clear bad-input error, never a bug or numbers read as garbage."""
+    folder = _saved_l_shape(tmp_path)
+    size = (folder / name).stat().st_size
+    for damage in ("truncate", "garble"):
+        original = (folder / name).read_bytes()
+        if damage == "truncate":
+            (folder / name).write_bytes(original[: size // 2])
+        else:
+            _garble(folder / name, 4)
+        with pytest.raises(InputError, match="corrupt zone graph"):
+            load_zone_graph(folder)
+        (folder / name).write_bytes(original)
+    assert load_zone_graph(folder).n_zones > 0
+
+
+def test_a_truncated_zones_brep_is_invalid_input(tmp_path):
+    folder = _saved_l_shape(tmp_path)
+    brep = folder / "zones.brep"
+    brep.write_bytes(brep.read_bytes()[: brep.stat().st_size // 2])
+    with pytest.raises(InputError, match="corrupt zone graph"):
+        load_zone_graph(folder)
+    assert load_zone_graph(folder, solids=False).n_zones > 0

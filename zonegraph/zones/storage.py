@@ -123,11 +123,67 @@ def load_zone_graph(folder: str | Path, solids: bool = True) -> ZoneGraph:
         solids: also read the zone solids (``zones.brep``); skip them for array-only work.
 
     Raises:
-        InputError: no graph in the folder.
+        InputError: no graph in the folder, or one whose files are unreadable or inconsistent
+            (garbled or truncated bytes are bad input, never read as numbers).
     """
     folder = Path(folder)
     if not (folder / "zones.parquet").is_file():
         raise InputError(str(folder), "no zone graph here (zones.parquet missing)")
+    try:
+        graph = _read(folder, solids)
+    except (OSError, ValueError, KeyError, TypeError, IndexError, pa.ArrowException) as exc:
+        raise InputError(str(folder), f"corrupt zone graph ({type(exc).__name__}: {_one_line(exc)})") from exc
+    problem = _inconsistency(graph)
+    if problem:
+        raise InputError(str(folder), f"corrupt zone graph: {problem}")
+    return graph
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())[:200] or "no message"
+
+
+def _inconsistency(graph: ZoneGraph) -> str | None:
+    """What in a read graph cannot come from :func:`save_zone_graph`, or None: non-finite or
+    negative measures (normals and offsets are NaN off planes), indices out of range, a zone
+    solid per zone missing."""
+    measures = {  # always finite
+        "zone volumes": graph.zone_volume,
+        "zone centroids": graph.zone_centroid,
+        "zone boxes": graph.zone_bbox,
+        "face areas": graph.face_area,
+        "face centroids": graph.face_centroid,
+    }
+    planar = {  # NaN where the face or surface is not a plane
+        "face normals": graph.face_normal,
+        "surface offsets": graph.surface_offset,
+        "surface normals": graph.surface_normal,
+    }
+    for name, values in measures.items():
+        if not np.isfinite(values).all() or (np.abs(values) > 1e6).any():
+            return f"{name} not finite or out of range"
+    for name, values in planar.items():
+        if np.isinf(values).any() or (np.abs(np.nan_to_num(values)) > 1e6).any():
+            return f"{name} out of range"
+    if (graph.zone_volume < 0).any() or (graph.face_area < 0).any():
+        return "negative zone volume or face area"
+    n_zones, n_faces, n_surfaces = graph.n_zones, len(graph.face_area), len(graph.surface_offset)
+    if graph.face_zones.size and (graph.face_zones.min() < -1 or graph.face_zones.max() >= n_zones):
+        return "a face names a zone that does not exist"
+    if graph.face_surface.size and (graph.face_surface.min() < 0 or graph.face_surface.max() >= n_surfaces):
+        return "a face names a surface that does not exist"
+    if graph.face_links.size and (graph.face_links.min() < 0 or graph.face_links.max() >= n_faces):
+        return "a link names a face that does not exist"
+    if not np.isin(graph.plane_side, (-1, 0, 1)).all():
+        return "plane sides other than -1, 0, 1"
+    if len(graph.zone_points) != n_zones:
+        return f"{len(graph.zone_points)} sample rows for {n_zones} zones"
+    if graph.solids is not None and len(graph.solids) != n_zones:
+        return f"zones.brep holds {len(graph.solids)} solids for {n_zones} zones (truncated?)"
+    return None
+
+
+def _read(folder: Path, solids: bool) -> ZoneGraph:
     zones = pq.read_table(folder / "zones.parquet")
     meta = json.loads(zones.schema.metadata[META_KEY])
     faces = pq.read_table(folder / "faces.parquet")
@@ -173,5 +229,6 @@ def _read_solids(path: Path) -> list[TopoDS_Shape] | None:
     if not path.is_file():
         return None
     shape = TopoDS_Shape()
-    BRepTools.Read_s(shape, str(path), BRep_Builder())
+    if not BRepTools.Read_s(shape, str(path), BRep_Builder()) or shape.IsNull():
+        raise ValueError(f"{path.name} is not a readable BREP file")
     return [TopoDS.Solid(s) for s in sub_shapes(shape, TopAbs_SOLID)]
