@@ -179,6 +179,67 @@ def data_version(labels_dir: str | Path) -> str:
     return h.hexdigest()[:12]
 
 
+def metric_name(key: str) -> str:
+    """The dashboard's groups: ``train_loss`` -> ``loss/train``, ``val_rank`` -> ``val/rank``,
+    ``best_val_rank`` -> ``best/val_rank``, ``seconds`` -> ``time/epoch_s``."""
+    if key.startswith("best_"):
+        return f"best/{key[5:]}"
+    if key.endswith("_loss"):
+        return f"loss/{key[:-5]}"
+    if key.startswith("val_"):
+        return f"val/{key[4:]}"
+    return {"seconds": "time/epoch_s"}.get(key, key)
+
+
+def run_name(config: TrainConfig, train_designs: int) -> str:
+    """What the dashboard lists: the fusion, the objective, the data and the seed."""
+    features = " +features" if config.features else ""
+    return f"{config.fusion} {config.loss}{features} {train_designs} designs seed{config.seed}"
+
+
+def log_labels(labels_dir: str | Path, version: str) -> None:
+    """The label shards as the run's training dataset: one row per labelled step."""
+    import mlflow
+
+    steps = Path(labels_dir) / "steps"
+    if not any(steps.glob("*.parquet")):
+        return
+    table = ds.dataset(steps).to_table(columns=["design_id", "split", "step", "proposals", "captured"])
+    dataset = mlflow.data.from_pandas(
+        table.to_pandas(), source=str(Path(labels_dir).resolve()), name=f"labels-{version}"
+    )
+    mlflow.log_input(dataset, context="training")
+
+
+def log_scorer(path: Path) -> None:
+    """The best checkpoint as an MLflow PyTorch model with the signature of a batch of states
+    (``zonegraph.network.encoding.StateData``: S surface samples per zone), beside the raw ``.pt``
+    that the ``net`` guide loads."""
+    import mlflow
+    from mlflow.models import ModelSignature
+    from mlflow.types.schema import Schema, TensorSpec
+
+    from zonegraph.network.checkpoint import load_scorer
+
+    inputs = Schema(
+        [
+            TensorSpec(np.dtype(np.float32), (-1, 4), "x"),
+            TensorSpec(np.dtype(np.int64), (2, -1), "edge_index"),
+            TensorSpec(np.dtype(np.int64), (-1,), "proposal"),
+            TensorSpec(np.dtype(np.int64), (-1,), "zone_of"),
+            TensorSpec(np.dtype(np.float32), (-1, 6, -1), "points"),
+        ]
+    )
+    outputs = Schema([TensorSpec(np.dtype(np.float32), (-1, 2), "logits")])
+    mlflow.pytorch.log_model(
+        load_scorer(path),
+        name="scorer",
+        signature=ModelSignature(inputs=inputs, outputs=outputs),
+        pip_requirements=["torch", "torch-geometric", "zonegraph"],
+        serialization_format="pickle",  # pt2 traces forward() on tensors; it takes a PyG batch
+    )
+
+
 def git_commit() -> str:
     try:
         out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, check=True)
@@ -305,7 +366,8 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminated)  # a killed training's run ends FAILED, not RUNNING
     tags = {"zonegraph.host": socket.gethostname(), "zonegraph.pid": str(os.getpid())}
-    with mlflow.start_run(run_id=last["run_id"] if last else None, tags=tags) as run:
+    name = None if last else run_name(config, len(train_ids))
+    with mlflow.start_run(run_id=last["run_id"] if last else None, run_name=name, tags=tags) as run:
         sizes = {
             "train_designs": len(train_ids),
             "val_designs": len(val_ids),
@@ -315,6 +377,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
         if last is None:
             mlflow.log_params({**asdict(config), **sizes, "device": str(device)})
             mlflow.set_tags(tags)
+            log_labels(config.labels_dir, version)
         else:
             resumed = {f"resumed_at_epoch_{first}": str(device), "git_commit_resumed": tags["git_commit"]}
             mlflow.set_tags(resumed)
@@ -345,7 +408,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
                 print(f"epoch {epoch}: the training loss is not finite; stopping", flush=True)
                 break
             curve.append(row)
-            mlflow.log_metrics({k: v for k, v in row.items() if k != "epoch"}, step=epoch)
+            mlflow.log_metrics({metric_name(k): v for k, v in row.items() if k != "epoch"}, step=epoch)
             print(
                 f"epoch {epoch}: " + ", ".join(f"{k} {v:.4f}" for k, v in row.items() if k != "epoch"),
                 flush=True,
@@ -358,8 +421,9 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
             raise SystemExit("train: no epoch finished with a finite loss; no checkpoint written")
         write_curves(curve, out)
         (out / "metrics.json").write_text(json.dumps({**best, "run_id": run.info.run_id}, indent=2))
-        mlflow.log_metrics({f"best_{k}": v for k, v in best.items() if k != "epoch"})
+        mlflow.log_metrics({metric_name(f"best_{k}"): v for k, v in best.items() if k != "epoch"})
         mlflow.log_artifact(str(out / "scorer.pt"))
+        log_scorer(out / "scorer.pt")
         mlflow.log_artifact(str(out / "curve.png"))
     return best
 

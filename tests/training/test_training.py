@@ -130,7 +130,8 @@ def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_pat
         runs = search_runs(url, "zonegraph-scorer")
     run = next(r for r in runs if r["info"]["run_id"] == metrics["run_id"])
     names = {m["key"] for m in run["data"]["metrics"]}
-    assert {"train_loss", "val_loss", "val_rank", "best_val_rank"} <= names
+    assert {"loss/train", "loss/val", "val/rank", "val/normalised", "best/val_rank"} <= names
+    assert run["info"]["run_name"].startswith("late focal")
     tags = {t["key"]: t["value"] for t in run["data"]["tags"]}
     assert len(tags["data_version"]) == 12 and tags["git_commit"]
     # The network guide: a ranker the core reaches by reference, without importing torch.
@@ -285,7 +286,7 @@ def test_a_stopped_run_resumes_from_its_last_epoch_in_the_same_mlflow_run(labell
     )
     assert moved > 1e-3
     client = mlflow.tracking.MlflowClient(tracking_uri="sqlite:///mlflow.db")
-    history = client.get_metric_history(broken["run_id"], "val_normalised")
+    history = client.get_metric_history(broken["run_id"], "val/normalised")
     assert sorted(m.step for m in history) == [1, 2]  # one MLflow run across the interruption
     assert json.loads((tmp_path / "broken" / "metrics.json").read_text())["run_id"] == broken["run_id"]
     train(replace(base, out_dir="broken", lr=0.01), fresh=False)  # other settings: a new run
