@@ -91,8 +91,8 @@ def test_each_hostile_model_is_one_row_and_the_rest_converts(tmp_path: Path) -> 
         "segfault": "crash",
         "spins": "timeout",
     }
-    assert rows["exits"]["reason"] == "worker died (exit code 0)"
-    assert rows["segfault"]["reason"] == "worker died (exit code -11)"
+    assert rows["exits"]["reason"] == "worker exited without a result (exit code 0)"
+    assert rows["segfault"]["reason"] == "worker died (exit code -11, SIGSEGV)"
     assert rows["sys_exit"]["reason"] == "SystemExit: 3"
     assert rows["spins"]["reason"] == "no result after 5 s"
     assert sorted(p.name for p in out.glob("[!.]*")) == ["good.json", "summary.json"]
