@@ -9,8 +9,9 @@ so after a failure the folder holds nothing that looks current, and after a succ
 run's files.
 
 One run writes into an ``--out`` at a time: a second one finds its lock (``.OUT.lock`` beside it,
-an ``flock`` the kernel drops when the holder dies) and refuses in one line, instead of two runs
-mixing their files. Whoever holds the lock also removes the scratch folders that killed runs left.
+an ``flock`` the kernel drops when the holder dies, removed when the run ends) and refuses in one
+line, instead of two runs mixing their files. Whoever holds the lock also removes the scratch
+folders that killed runs left.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import IO
 
 from zonegraph.errors import ZoneGraphError
 from zonegraph.isolation import Outcome
@@ -56,15 +58,28 @@ def writer_lock(out: Path) -> Iterator[None]:
     Raises:
         ZoneGraphError: another run holds it (``invalid_input``: the command's input is the folder)."""
     path = out.parent / f".{out.name}.lock"
-    with open(path, "a") as handle:
+    while True:
+        handle = open(path, "a")
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
+            handle.close()
             raise ZoneGraphError(str(out), "another zonegraph run is writing this folder") from None
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+        if _same_file(handle, path):
+            break
+        handle.close()  # the holder removed it between our open and our lock: take the new one
+    try:
+        yield
+    finally:
+        path.unlink(missing_ok=True)  # nothing of the lock stays beside the user's folder
+        handle.close()
+
+
+def _same_file(handle: IO[str], path: Path) -> bool:
+    try:
+        return os.fstat(handle.fileno()).st_ino == os.stat(path).st_ino
+    except FileNotFoundError:
+        return False
 
 
 def _remove_listed(out: Path) -> None:

@@ -78,9 +78,9 @@ COMPLETE = {
 }
 # The command's own stdout lines on success; anything else on stdout or stderr is noise.
 OWN_LINES = {
-    "replay": (r"\S.*: \d+ extrudes, \d+ bodies, ", r"  vs the file's properties: "),
-    "build": (r"\S.*: status \w+, \d+ zones ", r"  built in "),
-    "infer": (r"\S.*: \w+, \d+ steps ", r"  \d+ zones, build "),
+    "replay": (r"\S.*: \d+ extrudes?, \d+ bod(y|ies), ", r"  vs the file's properties: "),
+    "build": (r"\S.*: status \w+, \d+ zones? ", r"  built in "),
+    "infer": (r"\S.*: \w+, \d+ steps? ", r"  \d+ zones?, build ", r"  why: "),
 }
 ERROR_PREFIX = "zonegraph: error:"
 INTERNAL = re.compile(r"\(\w+\.py:\d+\)")  # an exception's file:line passed off as a user error
