@@ -17,8 +17,8 @@ joins the columns of neighbouring faces (a cylinder lying across the sweep, tang
 the columns meet), of every face on s under the zones swept; a sketch needs all the faces its
 faces' sweeps lie on, and a face that fails rejects the whole sketch. A face inside one zone (a
 face-loop strip or a kept freeform face that ends within the zone: the general fuse leaves it
-dangling, with that zone on both sides) bounds nothing: a sweep passes it and no sketch uses it. Sweeps are memoised per
-(face, s, e): the geometry never changes during search.
+dangling, with that zone on both sides) bounds nothing: a sweep passes it and no sketch uses it.
+Sweeps are memoised per (face, s, e): the geometry never changes during search.
 """
 
 from __future__ import annotations
@@ -278,8 +278,9 @@ class ProposalGenerator:
         """For every face, whether a sweep along d (from s to e) goes on through it out of its
         first zone, and out of its second (memoised per plane pair): a planar face when it faces
         along d (a cap); a curved face unless it lies on a cylinder or extrusion along d (a side
-        wall); never a face inside one zone (the sweep is on both of its sides already). Classifying all faces at once replaced a per-face test that was half a sweep's
-        cost on graphs of thousands of zones."""
+        wall); never a face inside one zone (the sweep is on both of its sides already).
+        Classifying all faces at once replaced a per-face test that was half a sweep's cost on
+        graphs of thousands of zones."""
         key = (s, e)
         if key not in self._crossed:
             g = self.graph
