@@ -14,7 +14,8 @@ rules is measured on the same geometry without rebuilding it. Then, for each des
 whether the GT step (its zone set and operation) is among them. Prints, by folder: GT steps
 captured / mappable steps (the steps a proposal could have: mapped, not an intersect, changing the
 canvas), first steps captured, designs with every step captured, proposals per state (mean, max)
-and generation seconds (setup, per state mean and max); writes ``results.json`` and ``results.md``.
+and generation seconds, wall and CPU (setup, per state mean and max; wall is contended on a shared
+machine, CPU is not); writes ``results.json`` and ``results.md``.
 """
 
 from __future__ import annotations
@@ -82,27 +83,28 @@ def prepared(design_id: str, designs: Path, cache: Path, timeout: float) -> Prep
 
 def measure(p: Prepared, level: int) -> dict:
     """Walk the GT path with a fresh generator: capture, proposal counts and times per state."""
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     gen = ProposalGenerator(p.graph, level=level)
-    setup = time.perf_counter() - t0
+    setup, setup_cpu = time.perf_counter() - t0, time.process_time() - c0
     canvas = np.zeros(p.graph.n_zones, bool)
     steps = []
     for i, (zones, operation, mapped) in enumerate(zip(p.zones, p.operations, p.mapped, strict=True)):
         after = apply_operation(operation, canvas, zones)
-        t1 = time.perf_counter()
+        t1, c1 = time.perf_counter(), time.process_time()
         props = gen.proposals(canvas)
-        seconds = time.perf_counter() - t1
+        seconds, cpu = time.perf_counter() - t1, time.process_time() - c1
         op = search_op(operation)
         mappable = mapped and op is not None and not np.array_equal(after, canvas)
         key = (np.packbits(zones).tobytes(), int(op)) if op is not None else None
         captured = mappable and any(q.key == key for q in props)
         effect = mappable and any(np.array_equal(q.apply(canvas), after) for q in props)
         steps.append(dict(index=i, mappable=mappable, captured=captured, effect=effect))
-        steps[-1].update(proposals=len(props), seconds=seconds)
+        steps[-1].update(proposals=len(props), seconds=seconds, cpu_s=cpu)
         canvas = after
     return dict(
         zones=p.graph.n_zones,
         setup_s=setup,
+        setup_cpu_s=setup_cpu,
         reaches=bool(np.array_equal(canvas, p.graph.zone_inside)),
         steps=steps,
     )
@@ -126,8 +128,8 @@ def table(rows: list[dict]) -> str:
     """Markdown figures by folder and overall."""
     lines = [
         "| folder | designs | GT steps captured | effect-captured | first steps | all steps "
-        "| proposals/state mean, max | setup s | s/state mean, max |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| proposals/state mean, max | setup s (CPU) | s/state mean, max | CPU s/state mean, max |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     folders = sorted({r["folder"] for r in rows}) + ["all"]
     for folder in folders:
@@ -139,12 +141,14 @@ def table(rows: list[dict]) -> str:
         whole = sum(r["reaches"] and all(s["captured"] for s in r["steps"]) for r in rs)
         props = [s["proposals"] for s in st] or [0]
         secs = [s["seconds"] for s in st] or [0.0]
+        cpus = [s["cpu_s"] for s in st] or [0.0]
         setup = sum(r["setup_s"] for r in rs)
+        setup_cpu = sum(r["setup_cpu_s"] for r in rs)
         lines.append(
             f"| {folder} | {len(rs)} (+{failed} failed) | {sum(s['captured'] for s in mp)} / {len(mp)} "
             f"| {sum(s['effect'] for s in mp)} | {sum(s['captured'] for s in first)} / {len(first)} "
-            f"| {whole} | {np.mean(props):.0f}, {max(props)} | {setup:.2f} "
-            f"| {np.mean(secs):.4f}, {max(secs):.3f} |"
+            f"| {whole} | {np.mean(props):.0f}, {max(props)} | {setup:.2f} ({setup_cpu:.2f}) "
+            f"| {np.mean(secs):.4f}, {max(secs):.3f} | {np.mean(cpus):.4f}, {max(cpus):.3f} |"
         )
     return "\n".join(lines)
 
@@ -189,7 +193,7 @@ def _line(row: dict) -> str:
     mp = [s for s in row["steps"] if s["mappable"]]
     return (
         f"{row['zones']} zones, {sum(s['captured'] for s in mp)}/{len(mp)} captured, "
-        f"{sum(s['seconds'] for s in row['steps']):.2f} s"
+        f"{sum(s['seconds'] for s in row['steps']):.2f} s ({sum(s['cpu_s'] for s in row['steps']):.2f} CPU s)"
     )
 
 

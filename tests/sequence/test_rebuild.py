@@ -52,6 +52,9 @@ def test_a_zone_exact_program_rebuilds_exactly(batch, design_id, tmp_path):
         ("08_21plus/batch_001.py", "23325_292b3294_0000", True),
         # a valid rebuild whose tolerances (6e-3) swallow the target's 2e-6 steps in every common
         ("07_16to20ops/batch_001.py", "128645_d5cdd476_0002", False),
+        # the last union enlarged the tolerances of the part after a cut in place, which then
+        # held 2e-4 less of the part (a program of fix 2's multi-face sweeps)
+        ("05_8to10ops/batch_009.py", "54597_893331b6_0000", True),
     ],
 )
 def test_a_zone_exact_program_rebuilds_where_sequential_booleans_fail(batch, design_id, simplify):

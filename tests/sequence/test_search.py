@@ -57,10 +57,12 @@ def test_sweeps_fill_their_prisms_exactly():
     g = graph_of(Box(6, 4, 2) - Pos(0, 0, 0.5) * Box(2, 1, 1), simplify=False)
     gen = ProposalGenerator(g)
     gen.proposals(np.zeros(g.n_zones, bool))
-    for (face, s, e), zones in gen._sweeps.items():
-        if zones is not None:
+    for (face, s, e), swept in gen._sweeps.items():
+        if swept is not None:
             length = np.linalg.norm(gen.direction(s, e))
-            assert g.zone_volume[zones].sum() == pytest.approx(g.face_area[face] * length, rel=1e-4)
+            assert face in swept.faces
+            area = g.face_area[list(swept.faces)].sum()
+            assert g.zone_volume[swept.zones].sum() == pytest.approx(area * length, rel=1e-4)
 
 
 def test_search_never_undoes_its_own_steps():

@@ -9,6 +9,7 @@ from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepAlgoAPI import BRepAlgoAPI_BooleanOperation
 from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.BRepGProp import BRepGProp
 from OCP.collections import (
     IndexedDataMap_TopoDS_Shape_List_TopoDS_Shape_TopTools_ShapeMapHasher as AncestorMap,
@@ -78,12 +79,16 @@ def fuzzy_boolean(
 ) -> TopoDS_Shape:
     """``a`` (op) ``b`` with sub-shapes closer than ``fuzzy`` taken as coincident: two faces a
     hair apart are OpenCASCADE's hardest Boolean case, which a fuzzy value turns into its easiest.
+    It runs on copies: a Boolean grows the tolerances of its operands in place, so that a part kept
+    from an earlier step (a rebuild's state, the body of the next alternative tried) would change
+    under it and later Booleans with it lose volume. OpenCASCADE's own non-destructive mode is no
+    substitute: it returned an empty union of two valid prisms of a corpus part.
 
     Raises:
         ValueError: the Boolean reported errors.
     """
-    operation.SetArguments(shape_list([a]))
-    operation.SetTools(shape_list([b]))
+    operation.SetArguments(shape_list([BRepBuilderAPI_Copy(a).Shape()]))
+    operation.SetTools(shape_list([BRepBuilderAPI_Copy(b).Shape()]))
     operation.SetFuzzyValue(fuzzy)
     operation.SetRunParallel(False)
     operation.Build()

@@ -175,7 +175,8 @@ def execute(program: list[ProgramStep]) -> list[Shape | None]:
 def _step(shape: Shape, tools: list[Shape], ops: list[Op], by_cells: bool) -> tuple[Shape, bool]:
     """The part after the last of ``ops`` from the part before it (``shape``), and whether it came
     from the cells: first from the cells when the part before did, then from the Booleans, then
-    from the cells; a valid result first, else one from the Booleans, else one at all.
+    from the cells; a valid result first (from the Booleans, one with a possible volume too),
+    else one from the Booleans, else one at all.
 
     Raises:
         RebuildError: neither the Booleans nor the cells gave a result (``result.json`` says so).
@@ -184,8 +185,8 @@ def _step(shape: Shape, tools: list[Shape], ops: list[Op], by_cells: bool) -> tu
     cells = _cells_rebuild(ops, tools, diag) if by_cells else None
     if cells is not None and cells.is_valid:
         return cells, True
-    combined = _combine(shape, tools[-1], ops[-1])
-    if combined is not None and combined.is_valid:
+    combined, accepted = _combine(shape, tools[-1], ops[-1])
+    if accepted and combined is not None:
         return combined, False
     if not by_cells:
         cells = _cells_rebuild(ops, tools, diag)
@@ -197,9 +198,10 @@ def _step(shape: Shape, tools: list[Shape], ops: list[Op], by_cells: bool) -> tu
     return combined, False
 
 
-def _combine(shape: Shape, tool: Shape, op: Op) -> Shape | None:
+def _combine(shape: Shape, tool: Shape, op: Op) -> tuple[Shape | None, bool]:
     """``shape`` fused with or cut by ``tool``, trying in turn: the operands as they are, the tool
-    repaired, fuzzy values, and the part so far repaired. The first result the checker accepts
+    repaired, fuzzy values, and the part so far repaired; with whether the result is accepted.
+    The first result the checker accepts with a volume the operation allows (:func:`_possible`)
     wins, else the first result as it came: an invalid part often still takes the next Booleans,
     while repairing one in place can break the next union (``docs/results/evidence.md``). None
     when every Boolean failed."""
@@ -207,11 +209,27 @@ def _combine(shape: Shape, tool: Shape, op: Op) -> Shape | None:
     first = None
     for x, y, share in _alternatives(shape, tool):
         result = _boolean(x, y, op, share * diag)
-        if result is not None and result.is_valid:
-            return result
+        if result is not None and result.is_valid and _possible(shape, tool, op, result):
+            return result, True
         if first is None:
             first = result
-    return first
+    return first, False
+
+
+# Relative slack of :func:`_possible`'s volume bounds, for volume integration error: a failed
+# Boolean that the checker accepts loses far more (a valid union of a corpus part that held 1%).
+POSSIBLE_RTOL = 1e-5
+
+
+def _possible(shape: Shape, tool: Shape, op: Op, result: Shape) -> bool:
+    """Whether ``result``'s volume is one ``shape`` (op) ``tool`` can have: a union holds at least
+    the larger operand and at most both, a cut at most the part and at least the part less the
+    tool. The checker accepts some results that lose most of the part."""
+    part, cutter, out = shape.volume, tool.volume, result.volume
+    slack = POSSIBLE_RTOL * (part + cutter)
+    if op is Op.UNION:
+        return max(part, cutter) - slack <= out <= part + cutter + slack
+    return part - cutter - slack <= out <= part + slack
 
 
 def _cells_rebuild(ops: list[Op], tools: list[Shape], diag: float) -> Shape | None:

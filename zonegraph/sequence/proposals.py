@@ -12,8 +12,13 @@ group's components, or (proposal level k) any 1..k or N-k..N of them. Each sketc
 along d to e through the zones it meets: from the face into the zone beyond it, then across that
 zone's caps (planar faces facing along d, and curved faces not on a cylinder or extrusion along d),
 never its side walls (cylinders and extrusions along d), until plane e. The zones swept must fill
-the prism exactly (volume = face area x |d|, relative 1e-4); a face that fails rejects the whole
-sketch. Sweeps are memoised per (face, s, e): the geometry never changes during search.
+the prism exactly (volume = face area x |d|, relative 1e-4) of the face or, where a curved cap
+joins the columns of neighbouring faces (a cylinder lying across the sweep, tangent to s where
+the columns meet), of every face on s under the zones swept; a sketch needs all the faces its
+faces' sweeps lie on, and a face that fails rejects the whole sketch. A face inside one zone (a
+face-loop strip or a kept freeform face that ends within the zone: the general fuse leaves it
+dangling, with that zone on both sides) bounds nothing: a sweep passes it and no sketch uses it.
+Sweeps are memoised per (face, s, e): the geometry never changes during search.
 """
 
 from __future__ import annotations
@@ -32,6 +37,18 @@ PARALLEL_TOL = 1e-9
 MIN_DISTANCE = 1e-5  # normalised units: closer parallel planes are not an extrusion
 PRISM_RTOL = 1e-4
 SIDE_WALL_KINDS = ("cylinder", "extrusion")  # curved surfaces a sweep along their axis runs beside
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """The zones a face's prism from s to e is made of, and the faces on s they stand on.
+
+    Shapes:
+        zones: (Z,) bool.
+    """
+
+    zones: np.ndarray
+    faces: tuple[int, ...]  # the face swept, and the faces it shares its zones with (sorted)
 
 
 class Op(enum.IntEnum):
@@ -112,12 +129,13 @@ class ProposalGenerator:
         self.graph = graph
         self.level = level
         self.target = graph.zone_inside.astype(bool)
+        self.internal = self._internal_faces()
         planes = graph.planes
         self.pairs = self._plane_pairs(planes)
         self.faces_on = {int(s): np.flatnonzero(graph.face_surface == s) for s in planes}
         self._links_on = self._links_by_plane(planes)
         self._zone_faces = self._faces_of_zones()
-        self._sweeps: dict[tuple[int, int, int], np.ndarray | None] = {}
+        self._sweeps: dict[tuple[int, int, int], Sweep | None] = {}
         self._face_zone_list = [tuple(pair) for pair in graph.face_zones.tolist()]
         self._face_surface_list = graph.face_surface.tolist()
         self._zone_face_lists = [faces.tolist() for faces in self._zone_faces]
@@ -139,6 +157,13 @@ class ProposalGenerator:
             if abs(g.surface_offset[e] * float(ns @ ne) - g.surface_offset[s]) > MIN_DISTANCE:
                 pairs.append((s, e))
         return pairs
+
+    def _internal_faces(self) -> np.ndarray:
+        """(F,) bool: faces with one zone that are not on the box, so that zone lies on both sides."""
+        g = self.graph
+        surface = g.face_surface
+        on_box = (surface >= 0) & g.surface_on_box[np.maximum(surface, 0)]
+        return (g.face_zones[:, 1] < 0) & (surface >= 0) & ~on_box
 
     def _links_by_plane(self, planes: np.ndarray) -> dict[int, list[tuple[int, int]]]:
         """Face links (edge-sharing faces, always on one surface) grouped by their plane."""
@@ -181,18 +206,19 @@ class ProposalGenerator:
         d = self.direction(s, e)
         faces = self.faces_on[s]
         forward = g.face_normal[faces] @ d > 0
-        return np.where(forward, g.face_zones[faces, 1], g.face_zones[faces, 0])
+        beyond = np.where(forward, g.face_zones[faces, 1], g.face_zones[faces, 0])
+        return beyond
 
     # -------------------------------------------------------------------------- sweeping
 
-    def sweep(self, face: int, s: int, e: int) -> np.ndarray | None:
-        """Zones of the prism over ``face`` from s to e, or None if they do not fill it exactly."""
+    def sweep(self, face: int, s: int, e: int) -> Sweep | None:
+        """The prism over ``face`` from s to e, or None if its zones do not fill it exactly."""
         key = (face, s, e)
         if key not in self._sweeps:
             self._sweeps[key] = self._sweep(face, s, e)
         return self._sweeps[key]
 
-    def _sweep(self, face: int, s: int, e: int) -> np.ndarray | None:
+    def _sweep(self, face: int, s: int, e: int) -> Sweep | None:
         g = self.graph
         d = self.direction(s, e)
         length = float(np.linalg.norm(d))
@@ -226,12 +252,20 @@ class ProposalGenerator:
                     return None
                 stack.append(other)
         zones = np.frombuffer(bytes(seen), np.uint8).astype(bool)
-        if (
-            abs(float(g.zone_volume[zones].sum()) - g.face_area[face] * length)
-            > PRISM_RTOL * g.face_area[face] * length
-        ):
+        volume = float(g.zone_volume[zones].sum())
+        if abs(volume - g.face_area[face] * length) <= PRISM_RTOL * g.face_area[face] * length:
+            return Sweep(zones, (face,))
+        under = self._faces_under(zones, s, e)
+        area = float(g.face_area[under].sum())
+        if face not in under or abs(volume - area * length) > PRISM_RTOL * area * length:
             return None
-        return zones
+        return Sweep(zones, tuple(under))
+
+    def _faces_under(self, zones: np.ndarray, s: int, e: int) -> list[int]:
+        """The faces on s whose zone along d (from s to e) is one of ``zones``, sorted."""
+        beyond = self._beyond[(s, e)]
+        valid = beyond >= 0
+        return self.faces_on[s][valid & zones[np.where(valid, beyond, 0)]].tolist()
 
     def _sides(self, plane: int) -> list[int]:
         """Each zone's side of a plane (``plane_side`` row) as a list: a sweep reads it zone by
@@ -244,8 +278,9 @@ class ProposalGenerator:
         """For every face, whether a sweep along d (from s to e) goes on through it out of its
         first zone, and out of its second (memoised per plane pair): a planar face when it faces
         along d (a cap); a curved face unless it lies on a cylinder or extrusion along d (a side
-        wall). Classifying all faces at once replaced a per-face test that was half a sweep's
-        cost on graphs of thousands of zones."""
+        wall); never a face inside one zone (the sweep is on both of its sides already).
+        Classifying all faces at once replaced a per-face test that was half a sweep's cost on
+        graphs of thousands of zones."""
         key = (s, e)
         if key not in self._crossed:
             g = self.graph
@@ -257,8 +292,8 @@ class ProposalGenerator:
             wall = (surface >= 0) & np.isin(g.surface_kind[np.maximum(surface, 0)], SIDE_WALL_KINDS)
             axis = g.surface_axis[np.maximum(surface, 0), 3:] @ d
             curved = ~wall | (1 - np.abs(axis) / length >= PARALLEL_TOL)
-            from_a = np.where(planar, along > PARALLEL_TOL * length, curved)
-            from_b = np.where(planar, -along > PARALLEL_TOL * length, curved)
+            from_a = np.where(planar, along > PARALLEL_TOL * length, curved) & ~self.internal
+            from_b = np.where(planar, -along > PARALLEL_TOL * length, curved) & ~self.internal
             self._crossed[key] = (from_a.tolist(), from_b.tolist())
         return self._crossed[key]
 
@@ -299,12 +334,19 @@ class ProposalGenerator:
         return sorted(sorted(c) for c in comps.values())
 
     def extrusion(self, faces: tuple[int, ...], s: int, e: int) -> np.ndarray | None:
+        """The zones of the sketch ``faces`` extruded from s to e, or None when a face's prism is
+        not filled exactly or stands on zones that faces outside the sketch stand on too."""
         volume = np.zeros(self.graph.n_zones, bool)
+        members: set[int] | None = None
         for f in faces:
             swept = self.sweep(f, s, e)
             if swept is None:
                 return None
-            volume |= swept
+            if len(swept.faces) > 1:
+                members = set(faces) if members is None else members
+                if not members.issuperset(swept.faces):
+                    return None
+            volume |= swept.zones
         return volume
 
     def _candidates(
