@@ -1,4 +1,4 @@
-"""The proposal-scoring network (paper sec. 4.2, ``ALGORITHM.md`` sec. 5).
+"""The proposal-scoring network (paper sec. 4.2, ``docs/algorithm.md`` sec. 6).
 
 A state (zone graph, canvas) and one proposal (extrusion zones, operation) give every zone four
 flags: in the target, in the canvas, in the extrusion, and the operation (+1 union, -1 subtract,

@@ -1,4 +1,4 @@
-"""Ground-truth sequences on zone graphs (paper sec. 4.2, ``../shared/docs/ALGORITHM.md`` sec. 4).
+"""Ground-truth sequences on zone graphs (paper sec. 4.2, ``docs/algorithm.md`` sec. 5).
 
 A design's extrude tools X_1..X_n (the replay's tool bodies, in the design's units) are mapped onto
 the zone graph of its final shape: a zone belongs to X_i when its verified interior point lies in

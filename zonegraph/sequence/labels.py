@@ -1,4 +1,4 @@
-"""Ternary training labels by random completions (paper sec. 4.2, ``ALGORITHM.md`` sec. 4).
+"""Ternary training labels by random completions (paper sec. 4.2, ``docs/algorithm.md`` sec. 6).
 
 At every ground-truth (GT) step i whose GT is captured, the proposals at C_{i-1} are those the
 search itself would see there: the same generator and level, minus inverses of the GT steps

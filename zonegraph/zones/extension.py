@@ -1,6 +1,6 @@
 """Face extension: the target's faces become surfaces that partition its bounding box.
 
-Rules (paper sec. 3, ``docs/ALGORITHM.md`` sec. 1): planes become planes across the box (or, for
+Rules (paper sec. 3, ``docs/algorithm.md`` sec. 1): planes become planes across the box (or, for
 face-loop walls when simplifying, strips along the loop's extrusion direction); circular cylinders
 become complete cylinders along their axis; other surfaces of linear extrusion are extended along
 the extrusion direction only; spheres become complete spheres; anything else keeps the face itself.
