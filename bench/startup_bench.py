@@ -2,7 +2,8 @@
 
     python -m bench.startup_bench [--designs data/designs/json] [--per-folder 3] [--seed 7]
                                   [--exclude FILE] [--budget 1] [--no-infer]
-                                  [--original DIR] [--freecad-python PY] [--out bench_out/startup]
+                                  [--original DIR] [--freecad-python PY] [--original-deps DIR]
+                                  [--timeout 600] [--out bench_out/startup]
 
 The parts: ``--per-folder`` designs of each timeline folder of the build123d corpus (``../shared``),
 drawn with ``--seed`` from those whose converted JSON is in ``--designs`` and whose id is not in
@@ -14,9 +15,13 @@ build PART.step`` (and ``infer PART.step --budget B``), measured by ``os.wait4``
 + sys of the process and every child it reaped, so a loaded machine does not inflate them), wall
 seconds and peak resident memory (the largest of the process and its children). The original
 implementation (brownvc/zone-graphs on FreeCAD) runs the same way when ``--original`` names its
-checkout and FreeCAD's Python module imports under ``--freecad-python``: one process that reads
-the STEP file and partitions it with its ``SpaceSplitter``; otherwise that column is skipped with
-the reason. Prints one row per part and the medians; writes ``results.json`` and ``results.md``.
+checkout and FreeCAD's Python module imports under ``--freecad-python`` (Debian's
+``freecad-python3`` package, for the system's ``/usr/bin/python3``): one process that reads the STEP
+file and partitions it with its ``SpaceSplitter``; otherwise that column is skipped with the reason.
+The original imports trimesh, which Debian does not package: ``--original-deps`` names a folder put
+on that interpreter's path (one holding a link to any trimesh will do). A process still running
+after ``--timeout`` seconds is killed and its row says so (rc -9). Prints one row per part and
+the medians; writes ``results.json`` and ``results.md``.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -44,6 +50,7 @@ FREECAD_PATHS = ("/usr/lib/freecad-python3/lib", "/usr/lib/freecad/lib")  # Debi
 ORIGINAL_DRIVER = """
 import sys
 sys.path[:0] = [{src!r}, *{paths!r}]
+import FreeCAD  # before Part: FreeCAD 0.20's Part module crashes when imported first
 import Part
 from utils.space_splitter import SpaceSplitter
 shape = Part.read({step!r})
@@ -63,12 +70,16 @@ class Run:
     tail: str = ""
 
 
-def measure(cmd: list[str], cwd: Path, env: dict[str, str] | None = None) -> Run:
-    """``cmd`` as a child process, measured by ``wait4`` (its own and its reaped children's use)."""
+def measure(cmd: list[str], cwd: Path, env: dict[str, str] | None = None, timeout: float = 600) -> Run:
+    """``cmd`` as a child process, measured by ``wait4`` (its own and its reaped children's use),
+    killed after ``timeout`` seconds (a partition that runs for hours must not stall the table)."""
     with tempfile.TemporaryFile() as out:
         t0 = time.perf_counter()
         proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=out, stderr=subprocess.STDOUT)
+        killer = threading.Timer(timeout, proc.kill)
+        killer.start()
         _, status, use = os.wait4(proc.pid, 0)
+        killer.cancel()
         wall = time.perf_counter() - t0
         proc.returncode = os.waitstatus_to_exitcode(status)
         out.seek(0)
@@ -103,16 +114,25 @@ def to_step(design: Path, folder: Path) -> Path:
     return (out / "final.step").rename(folder / f"{design.stem}.step")
 
 
-def original_problem(original: Path | None, python: str) -> str | None:
+def original_paths(args: argparse.Namespace) -> list[str]:
+    """What the original's interpreter needs on its path besides the checkout's ``src``."""
+    return [*FREECAD_PATHS, *([str(args.original_deps)] if args.original_deps else [])]
+
+
+def original_problem(original: Path | None, python: str, paths: list[str]) -> str | None:
     """Why the original implementation cannot run here, or None."""
     if original is None:
         return "no --original checkout of brownvc/zone-graphs given"
     if not (original / "src" / "utils" / "space_splitter.py").is_file():
         return f"{original} is not a brownvc/zone-graphs checkout (no src/utils/space_splitter.py)"
-    probe = f"import sys; sys.path[:0] = {list(FREECAD_PATHS)!r}; import FreeCAD"
-    proc = subprocess.run([python, "-c", probe], capture_output=True, text=True)
+    probe = f"import sys; sys.path[:0] = {paths!r}; import FreeCAD, Part, trimesh"
+    try:
+        proc = subprocess.run([python, "-c", probe], capture_output=True, text=True)
+    except OSError as exc:
+        return f"{python} cannot run: {exc.strerror}"
     if proc.returncode:
-        return f"FreeCAD's Python module does not import under {python}"
+        last = (proc.stderr.strip().splitlines() or [f"exit {proc.returncode}"])[-1]
+        return f"FreeCAD's Part or trimesh does not import under {python} ({last})"
     return None
 
 
@@ -126,10 +146,11 @@ def run_part(step: Path, work: Path, args: argparse.Namespace, original_ok: bool
         runs["infer"] = cli + ["infer", str(step), "--out", str(work / f"{step.stem}_infer"), *budget]
     if original_ok:
         src = args.original / "src"
-        code = ORIGINAL_DRIVER.format(src=str(src), paths=list(FREECAD_PATHS), step=str(step))
+        code = ORIGINAL_DRIVER.format(src=str(src), paths=original_paths(args), step=str(step))
         runs["original"] = [args.freecad_python, "-c", code]
     for name, cmd in runs.items():
-        run = measure(cmd, src if name == "original" else ROOT, None if name == "original" else env)
+        original = name == "original"
+        run = measure(cmd, src if original else ROOT, None if original else env, args.timeout)
         row[name] = asdict(run)
         print(
             f"  {step.stem} {name}: rc {run.rc}, cpu {run.cpu_s:.2f} s, wall {run.wall_s:.2f} s, "
@@ -154,6 +175,8 @@ def table(rows: list[dict], columns: list[str], skipped: str | None) -> str:
         for key, fmt in (("cpu_s", ".2f"), ("wall_s", ".2f"), ("peak_mb", ".0f")):
             medians.append(format(statistics.median(r[c][key] for r in rows), fmt))
     lines.append(f"| **median of {len(rows)}** | " + " | ".join(medians) + " |")
+    done = ", ".join(f"{c} {sum(r[c]['rc'] == 0 for r in rows)}" for c in columns)
+    lines.append(f"\nprocesses that exited 0, of {len(rows)}: {done}")
     small = min(rows, key=lambda r: r["step_bytes"])["build"]
     smallest = min(rows, key=lambda r: r["step_bytes"])["part"]
     lines.append(
@@ -195,13 +218,15 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--budget", type=float, default=1.0, help="infer's search seconds")
     p.add_argument("--no-infer", action="store_true")
     p.add_argument("--original", type=Path, default=None, help="a brownvc/zone-graphs checkout")
-    p.add_argument("--freecad-python", default="python3", help="the Python that imports FreeCAD")
+    p.add_argument("--freecad-python", default="/usr/bin/python3", help="the Python that imports FreeCAD")
+    p.add_argument("--original-deps", type=Path, default=None, help="a folder holding trimesh for it")
+    p.add_argument("--timeout", type=float, default=600, help="seconds before a process is killed")
     p.add_argument("--out", type=Path, default=ROOT / "bench_out" / "startup")
     p.add_argument("--prepare", type=Path, default=None, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     if args.prepare:
         return _prepare_here(args)
-    skipped = original_problem(args.original, args.freecad_python)
+    skipped = original_problem(args.original, args.freecad_python, original_paths(args))
     columns = ["build"] + ([] if args.no_infer else ["infer"]) + ([] if skipped else ["original"])
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
