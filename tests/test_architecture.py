@@ -32,7 +32,7 @@ RANK = {
     "export": 4,
     "network": 4,  # the network guide at inference: model, encoding, checkpoint, ranker
 }
-TOP = 5  # reconstruction, cli, batch, jobs, isolation, outputs and the package root
+TOP = 5  # reconstruction, cli, batch, jobs, build_job, isolation, outputs and the package root
 # The one layer that may import these, and which no other imports at module level: the rest reach
 # the network guide through zonegraph.plugins, by reference, so a core install never needs torch.
 TORCH = ("torch", "torch_geometric")

@@ -90,10 +90,24 @@ def _batch(job: Callable[[], BatchJob], args: argparse.Namespace) -> int | None:
         return None
     from zonegraph.status import Status
 
-    rows = run_batch(job(), collect_parts(args.targets), Path(args.out))
+    rows = run_batch(_load(job, args), collect_parts(args.targets), Path(args.out))
     if any(r.status == Status.BUG for r in rows):
         return EXIT_BUG
     return EXIT_USER_ERROR if any(not r.ok for r in rows) else 0
+
+
+def _load(job: Callable[[], BatchJob], args: argparse.Namespace) -> BatchJob:
+    """``job()``, which imports the geometry kernel, without the cyclic collector; then, in the
+    command's own process, the imported objects are frozen out of later collections, so that the
+    forked children that do the work neither walk them again nor copy their pages by touching
+    their collector headers."""
+    from zonegraph.lazy import uncollected
+
+    with uncollected():
+        loaded = job()
+    if args.own_process:
+        gc.freeze()
+    return loaded
 
 
 def _single(job: Callable[[], BatchJob], args: argparse.Namespace) -> Outcome:
@@ -108,15 +122,15 @@ def _single(job: Callable[[], BatchJob], args: argparse.Namespace) -> Outcome:
     reason = unrunnable(target)
     if reason:
         return Outcome(InputError.status, reason=reason)
-    run = job().run
+    run = _load(job, args).run
     return run_staged(lambda scratch: run(target, scratch), Path(args.out))
 
 
 def _build_job(config: BuildConfig, timeout: float) -> BatchJob:
     """``build_and_save`` in a killable child per part."""
     from zonegraph.batch import BatchJob, Column
+    from zonegraph.build_job import build_and_save
     from zonegraph.isolation import run_isolated
-    from zonegraph.jobs import build_and_save
 
     def run(target: Path, out: Path) -> Outcome:
         return run_isolated(build_and_save, (str(target), str(out), config, True), timeout=timeout)
@@ -484,6 +498,7 @@ def out_error(out: Path) -> str | None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run a command; ``argv`` None means this process is the command (the console script)."""
     args = build_parser().parse_args(argv)
+    args.own_process = argv is None  # in-process callers' objects must stay collectable
     func: Callable[[argparse.Namespace], int] = args.func
     error = argument_error(args)
     if error:

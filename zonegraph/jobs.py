@@ -3,6 +3,8 @@ returns only small plain data (the geometry goes to files).
 
 The design replay and the corpus converter need build123d, which a zone-graph build does not, so
 their modules are imported by the jobs that use them: ``zonegraph build PART.step`` stays on OCP.
+The build's own job lives in :mod:`zonegraph.build_job` (named here too), as this module's other
+jobs import the search and the labels, which a build does not need.
 """
 
 from __future__ import annotations
@@ -14,8 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pyarrow.parquet as pq
 
-from zonegraph.configs import BuildConfig
-from zonegraph.data.targets import load_kernel_target
+from zonegraph.build_job import build_and_save as build_and_save  # the pipeline's name for it
 from zonegraph.errors import ReplayMismatchError
 from zonegraph.geometry.shapes import read_shape, read_solids, write_step
 from zonegraph.isolation import run_isolated
@@ -26,8 +27,7 @@ from zonegraph.sequence.rankers import HeuristicRanker
 from zonegraph.status import Status
 from zonegraph.zones.build import build_zone_graph
 from zonegraph.zones.model import ZoneGraph, ZoneGraphBuildError
-from zonegraph.zones.sampling import export_zone_mesh
-from zonegraph.zones.storage import load_zone_graph, save_zone_graph
+from zonegraph.zones.storage import load_zone_graph
 
 if TYPE_CHECKING:
     from zonegraph.data.b123d import ConvertedDesign
@@ -57,27 +57,6 @@ def replay_and_save(design_path: str, out: Path, tolerance: float | None = None)
         summary["steps"][i]["step_file"] = name
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     return {"id": design.id, **summary}
-
-
-def build_and_save(
-    target: str, out: str, config: BuildConfig = BuildConfig(), mesh: bool = False
-) -> dict[str, Any]:
-    """Build the zone graph of a target file and save it to ``out``; returns its summary.
-
-    ``mesh`` also writes ``zones.ply`` (every zone, inside blue, outside grey) for a viewer.
-
-    Raises:
-        InputError: the file cannot be read as solids.
-        ZoneGraphBuildError: the graph cannot be built or breaks an invariant.
-    """
-    solids = load_kernel_target(target)
-    graph = build_zone_graph(
-        solids, simplify=config.simplify, samples=config.samples, seed=config.seed, source=target
-    )
-    save_zone_graph(graph, out)
-    if mesh:
-        export_zone_mesh(graph, Path(out) / "zones.ply")
-    return graph.summary()
 
 
 def ground_truth_and_coverage(

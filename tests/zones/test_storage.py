@@ -119,7 +119,8 @@ def test_cli_build_errors_are_one_line(tmp_path, args, message):
 
 def test_a_step_target_is_read_by_the_kernel_alone_as_build123d_reads_it(samples_dir, tmp_path):
     """``zonegraph build PART.step`` loads neither build123d nor trimesh nor scipy (each costs a
-    short command seconds and tens of MB), and reads the same solids as build123d's importer."""
+    short command seconds and tens of MB) nor the search, and reads the same solids as build123d's
+    importer."""
     from build123d import import_step
 
     from zonegraph.data.targets import load_kernel_target
@@ -129,9 +130,12 @@ def test_a_step_target_is_read_by_the_kernel_alone_as_build123d_reads_it(samples
     theirs = import_step(str(step)).solids()
     assert [volume_props(s)[0] for s in ours] == pytest.approx([s.volume for s in theirs], rel=1e-12)
     code = (
-        "import sys; from zonegraph.jobs import build_and_save\n"
+        "import sys; from zonegraph.cli import _build_job; from zonegraph.configs import BuildConfig\n"
+        "_build_job(BuildConfig(), 60)\n"  # what the command imports before its child
+        "from zonegraph.build_job import build_and_save\n"
         f"build_and_save({str(step)!r}, {str(tmp_path / 'g')!r}, mesh=True)\n"
-        "print(sorted(m for m in ('build123d', 'trimesh', 'scipy') if m in sys.modules))"
+        "heavy = ('build123d', 'trimesh', 'scipy', 'zonegraph.sequence', 'zonegraph.jobs')\n"
+        "print(sorted(m for m in heavy if m in sys.modules))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["[]"]
