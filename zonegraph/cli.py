@@ -256,6 +256,8 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     if not outcome.ok:  # the failed rows still say why, as a failed part's error.json does
         write_record(out, "summary.json", outcome.value)
     counts = json.loads(outcome.value)["counts"]
+    if not rows:
+        print(f"zonegraph: error: {args.source}: no def model_*() function in its batches", file=sys.stderr)
     for row in rows:
         if row.get("traceback"):
             print(row["traceback"], file=sys.stderr, end="")
