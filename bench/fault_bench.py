@@ -1,6 +1,7 @@
 """Faults injected into a small pipeline project, each trial checked against an uninterrupted run.
 
     python -m bench.fault_bench [--designs 6] [--trials 200] [--seed 0] [--out bench_out/faults]
+        [--kinds KIND ...] [--cycle]
 
 A reference run replays ``--designs`` synthetic designs, builds their zone graphs and labels them
 with the stages' own job bodies and runner (``pipelines.runner.run_jobs`` on the stages' local
@@ -236,20 +237,27 @@ def _values(record: dict) -> dict:
     return {k: v for k, v in record.items() if k not in VOLATILE and not k.endswith("_s")}
 
 
-def compare(project: Path, reference: Path, ref: dict, now: dict) -> tuple[int, int, int]:
-    """(lost, stale, wrong) of a trial's final records against the reference run's."""
+def compare(project: Path, reference: Path, ref: dict, now: dict) -> tuple[int, int, int, list[str]]:
+    """(lost, stale, wrong) of a trial's final records against the reference run's, and which
+    (``stage/design: what``)."""
     lost = stale = wrong = 0
+    which: list[str] = []
     for stage in STAGES:
         mine = {r["design_id"]: r for r in now[stage]}
         for r in ref[stage]:
             m = mine.get(r["design_id"])
+            where = f"{stage}/{r['design_id']}"
             if m is None or m["status"] != Status.OK:
                 lost += r["status"] == Status.OK
+                which += [f"{where}: lost"] if r["status"] == Status.OK else []
                 continue
             if _values(m) != _values(r):
                 wrong += 1
-            stale += not _same_files(stage, project, reference, r["design_id"])
-    return lost, stale, wrong
+                which.append(f"{where}: wrong")
+            if not _same_files(stage, project, reference, r["design_id"]):
+                stale += 1
+                which.append(f"{where}: stale")
+    return lost, stale, wrong, which
 
 
 def _same_files(stage: str, project: Path, reference: Path, design: str) -> bool:
@@ -286,9 +294,11 @@ def _same_table(paths: Any) -> bool:
     if not theirs.exists():
         return not mine.exists()
     try:
-        return bool(pq.read_table(mine).equals(pq.read_table(theirs)))
+        a, b = pq.read_table(mine), pq.read_table(theirs)
     except (OSError, ValueError):
         return False
+    timings = [c for c in a.column_names if c == "seconds" or c.endswith("_s")]  # differ run to run
+    return bool(a.drop_columns(timings).equals(b.drop_columns(timings)))
 
 
 def _damage(path: Path, kind: str, rng: np.random.Generator) -> None:
@@ -478,8 +488,9 @@ def main() -> None:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", type=Path, default=Path("bench_out/faults"))
     p.add_argument("--kinds", nargs="+", choices=KINDS, default=KINDS, help="the faults to draw from")
+    p.add_argument("--cycle", action="store_true", help="each kind in turn instead of drawn")
     args = p.parse_args()
-    table = run_bench(args.designs, args.trials, args.seed, args.out.resolve(), tuple(args.kinds))
+    table = run_bench(args.designs, args.trials, args.seed, args.out.resolve(), tuple(args.kinds), args.cycle)
     print(format_table(table))
 
 
@@ -574,11 +585,11 @@ def run_bench(
                 if not now["recomputed"]:
                     tally.notes.append(f"trial {i}: {kind} of {target.relative_to(project)} not detected")
             tally.notes += notes
-            lost, stale, wrong = compare(project, reference, ref, now)
+            lost, stale, wrong, which = compare(project, reference, ref, now)
             tally.lost, tally.stale, tally.wrong = tally.lost + lost, tally.stale + stale, tally.wrong + wrong
             tally.survived += not (lost or stale or wrong or notes)
             if lost or stale or wrong:
-                tally.notes.append(f"trial {i}: {kind} {design}: lost {lost}, stale {stale}, wrong {wrong}")
+                tally.notes.append(f"trial {i}: {kind} {design}: {', '.join(which)}")
             shutil.rmtree(project, ignore_errors=True)
     return dict(tallies)
 
