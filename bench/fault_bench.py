@@ -423,8 +423,8 @@ def _reason(record: dict) -> str:
 
 
 def _hostile_batch(kind: str, rng: np.random.Generator) -> bytes:
-    if kind in HOSTILE_MODELS:
-        return HOSTILE_MODELS[kind].encode()
+    if kind in HOSTILE_MODELS:  # a batch imports build123d (the converter records its extrude)
+        return f"from build123d import *\n\n\n{HOSTILE_MODELS[kind]}".encode()
     text = GOOD_MODELS.format(p="h_").encode()
     if kind == "convert_truncate":
         return text[: int(rng.integers(0, len(text)))]
