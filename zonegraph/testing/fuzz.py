@@ -83,7 +83,7 @@ COMPLETE = {
 OWN_LINES = {
     "replay": (r"\S.*: \d+ extrudes?, \d+ bod(y|ies), ", r"  vs the file's properties: "),
     "build": (r"\S.*: status \w+, \d+ zones? ", r"  built in "),
-    "infer": (r"\S.*: \w+, \d+ steps? ", r"  \d+ zones?, build ", r"  why: "),
+    "infer": (r"\S.*: \w+, (\d+ steps? |no step, )", r"  \d+ zones?, build ", r"  why: "),
     "convert": (r"\S+: \d+/\d+ converted$", r"converted \d+ of \d+ designs -> "),
 }
 CONVERT_ROW = re.compile(r"zonegraph: \S.*: \w+: (\w+): \S")  # a design's row: batch, id, status, reason
