@@ -1,7 +1,7 @@
 """The fuzz benchmark of issue 14: mutated real inputs through ``zonegraph replay|build|infer|convert``.
 
 Inputs: mutated sample designs (replay, build, infer), STEP files replayed from them (build,
-infer) and, one input in five, mutated one-model batches of the build123d corpus (convert, with
+infer) and, a share of them, mutated one-model batches of the build123d corpus (convert, with
 hostile statements such as endless loops, ``os._exit``, signals and unbounded allocation under
 ``--memory``); see ``zonegraph/testing/fuzz.py``.
 
