@@ -1,4 +1,9 @@
-"""The fuzz benchmark of issue 14: mutated real inputs through ``zonegraph replay|build|infer``.
+"""The fuzz benchmark of issue 14: mutated real inputs through ``zonegraph replay|build|infer|convert``.
+
+Inputs: mutated sample designs (replay, build, infer), STEP files replayed from them (build,
+infer) and, a share of them, mutated one-model batches of the build123d corpus (convert, with
+hostile statements such as endless loops, ``os._exit``, signals and unbounded allocation under
+``--memory``); see ``zonegraph/testing/fuzz.py``.
 
     python -m bench.fuzz_bench --inputs 1000 --seed 0 --out DIR [--timeout 20]
 

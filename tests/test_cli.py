@@ -224,3 +224,17 @@ def test_a_model_for_a_guide_that_uses_none_is_refused(samples_dir, tmp_path, ca
     refusal = "zonegraph: error: --model m.pt: the heuristic guide uses no model (only --guide net does)"
     assert lines == [refusal]
     assert not (tmp_path / "o").exists()
+
+
+def test_a_part_past_its_memory_limit_is_one_out_of_memory_line(samples_dir, tmp_path, capsys):
+    out = tmp_path / "out"
+    argv = ["build", str(samples_dir / "Couch.step"), "--out", str(out), "--samples", "1000000"]
+    assert main([*argv, "--memory", "300"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"zonegraph: error: {samples_dir / 'Couch.step'}: out_of_memory: "
+        "out of memory (MemoryError) past the 300 MiB memory limit"
+    ]
+    assert not out.exists()
+    assert main([*argv, "--memory", "0"]) == 2
+    assert capsys.readouterr().err.strip() == "zonegraph: error: --memory 0: must be a positive number"

@@ -140,3 +140,30 @@ def test_the_drawn_inputs_depend_on_the_seed_alone(tmp_path):
         return proc.stdout.strip()
 
     assert digest() == digest("with the probe module")
+
+
+def test_convert_runs_are_classed_by_their_design_rows(tmp_path):
+    """``convert`` says why in one row line per failed design, prints its progress whatever the
+    outcome, and keeps a failed run's summary.json."""
+    row = "zonegraph: b/batch_001.py: 123_ab_0000: timeout: no result after 10 s\n"
+    progress = "io/batch_001.py: 0/1 converted\nconverted 0 of 1 designs -> out (by status {})\n"
+    kept = ["summary.json", ".zonegraph-outputs.json"]
+    cases = {
+        "timeout": dict(stdout=progress, stderr=row, inside=kept),
+        "user": dict(stderr=row.replace("timeout", "syntax_error")),
+        "internal": dict(stderr=row.replace("no result after 10 s", "TypeError: x (convert.py:12)")),
+        "none": dict(stdout=progress),
+        "left": dict(stderr=row, inside=[*kept, "123_ab_0000.json"]),
+        "ok": dict(rc=0, stdout=progress.replace("0/1", "1/1"), inside=["summary.json", "1.json"]),
+        "no_json": dict(rc=0, stdout=progress, inside=["summary.json"]),
+    }
+    got = {name: _classified(tmp_path / name, command="convert", **kw)[0] for name, kw in cases.items()}
+    assert got == {
+        "timeout": "timeout",
+        "user": "user_error",
+        "internal": "traceback",
+        "none": "traceback",
+        "left": "partial_output",
+        "ok": "success",
+        "no_json": "partial_output",
+    }

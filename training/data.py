@@ -19,6 +19,7 @@ import pyarrow.dataset as ds
 import torch
 from torch_geometric.data import Dataset
 
+from training.shards import label_shards
 from zonegraph.network.encoding import Geometry, StateData, geometry_of, state_data
 from zonegraph.sequence.features import FEATURES
 from zonegraph.zones.storage import load_zone_graph
@@ -43,7 +44,8 @@ class _State:
 
 
 class LabelDataset(Dataset):
-    """States from the label shards of ``labels_dir`` whose designs are in ``design_ids``.
+    """States from the label shards of ``labels_dir`` whose designs are in ``design_ids``: only
+    the shards the labels stage lists as ok and intact (:func:`training.shards.label_shards`).
 
     ``mode="train"`` keeps positives and negatives only (the focal loss ignores neutrals; with
     ``neutrals`` the neutrals too, for a listwise loss that gives them partial credit) and at most
@@ -64,9 +66,10 @@ class LabelDataset(Dataset):
     ):
         super().__init__()
         self.mode, self.max_proposals, self.seed, self.neutrals = mode, max_proposals, seed, neutrals
-        table = ds.dataset(Path(labels_dir) / "proposals", format="parquet").to_table()
+        shards = label_shards(labels_dir)
+        table = ds.dataset(shards.proposals, format="parquet").to_table()
         self.has_features = all(f"feat_{name}" in table.column_names for name in FEATURES)
-        steps = ds.dataset(Path(labels_dir) / "steps", format="parquet").to_table()
+        steps = ds.dataset(shards.steps, format="parquet").to_table()
         if design_ids is not None:
             wanted = set(design_ids)
             table = table.filter(ds.field("design_id").isin(wanted))

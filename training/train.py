@@ -44,6 +44,7 @@ from torch_geometric.loader import DataLoader
 
 from training.data import LabelDataset
 from training.loss import LOSSES, focal_loss, listwise_loss
+from training.shards import label_shards
 from zonegraph.configs import Config, ConfigError, load_section
 from zonegraph.data.dataset import project_of, test_ids
 from zonegraph.network.model import ModelConfig, ProposalScorer
@@ -172,9 +173,10 @@ def rank_metrics(places: list[GTPlace], prefix: str = "val_") -> dict[str, float
 
 
 def data_version(labels_dir: str | Path) -> str:
-    """A short hash of the label shards' names and sizes: which labels a run saw."""
+    """A short hash of the names and sizes of the label shards read: which labels a run saw."""
     h = hashlib.sha1()
-    for path in sorted(Path(labels_dir).glob("*/*.parquet")):
+    shards = label_shards(labels_dir)
+    for path in sorted(shards.proposals + shards.steps):
         h.update(f"{path.parent.name}/{path.name}:{path.stat().st_size}".encode())
     return h.hexdigest()[:12]
 
@@ -201,10 +203,12 @@ def log_labels(labels_dir: str | Path, version: str) -> None:
     """The label shards as the run's training dataset: one row per labelled step."""
     import mlflow
 
-    steps = Path(labels_dir) / "steps"
-    if not any(steps.glob("*.parquet")):
+    steps = label_shards(labels_dir).steps
+    if not steps:
         return
-    table = ds.dataset(steps).to_table(columns=["design_id", "split", "step", "proposals", "captured"])
+    table = ds.dataset(steps, format="parquet").to_table(
+        columns=["design_id", "split", "step", "proposals", "captured"]
+    )
     dataset = mlflow.data.from_pandas(
         table.to_pandas(), source=str(Path(labels_dir).resolve()), name=f"labels-{version}"
     )
@@ -249,8 +253,9 @@ def git_commit() -> str:
 
 
 def labelled_designs(labels_dir: str | Path, split: str) -> list[str]:
-    """The designs of one split that have label shards."""
-    steps = ds.dataset(Path(labels_dir) / "steps", format="parquet").to_table(columns=["design_id", "split"])
+    """The designs of one split that have label shards (those training reads)."""
+    shards = label_shards(labels_dir).steps
+    steps = ds.dataset(shards, format="parquet").to_table(columns=["design_id", "split"])
     chosen = steps.filter(ds.field("split") == split).column("design_id").to_pylist()
     return sorted(set(chosen))
 

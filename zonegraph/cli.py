@@ -48,7 +48,9 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     tolerance = None if args.no_check else args.tolerance
 
     def run(scratch: Path) -> Outcome:
-        return run_isolated(replay_and_save, (args.design, scratch, tolerance), timeout=args.timeout)
+        return run_isolated(
+            replay_and_save, (args.design, scratch, tolerance), timeout=args.timeout, memory_mb=args.memory
+        )
 
     outcome = run_staged(run, out)
     if not outcome.ok:
@@ -126,14 +128,15 @@ def _single(job: Callable[[], BatchJob], args: argparse.Namespace) -> Outcome:
     return run_staged(lambda scratch: run(target, scratch), Path(args.out))
 
 
-def _build_job(config: BuildConfig, timeout: float) -> BatchJob:
-    """``build_and_save`` in a killable child per part."""
+def _build_job(config: BuildConfig, timeout: float, memory_mb: int | None) -> BatchJob:
+    """``build_and_save`` in a killable child per part, under ``memory_mb`` more MiB."""
     from zonegraph.batch import BatchJob, Column
     from zonegraph.build_job import build_and_save
     from zonegraph.isolation import run_isolated
 
     def run(target: Path, out: Path) -> Outcome:
-        return run_isolated(build_and_save, (str(target), str(out), config, True), timeout=timeout)
+        args = (str(target), str(out), config, True)
+        return run_isolated(build_and_save, args, timeout=timeout, memory_mb=memory_mb)
 
     def values(s: dict[str, Any]) -> dict[str, Any]:
         return {"status": s["status"], "zones": s["zones"]}
@@ -143,7 +146,7 @@ def _build_job(config: BuildConfig, timeout: float) -> BatchJob:
 
 def _cmd_build(args: argparse.Namespace) -> int:
     config = BuildConfig(simplify=not args.no_simplify, samples=args.samples, seed=args.seed)
-    job = partial(_build_job, config, args.timeout)
+    job = partial(_build_job, config, args.timeout, args.memory)
     status = _batch(job, args)
     if status is not None:
         return status
@@ -176,7 +179,7 @@ def _guide_error(config: InferConfig) -> str | None:
     return None
 
 
-def _infer_job(config: InferConfig, timeout: float) -> BatchJob:
+def _infer_job(config: InferConfig, timeout: float, memory_mb: int | None) -> BatchJob:
     """``infer`` in a killable child per part; a shipped or plugin guide's package (torch) is
     imported here too, so that a batch's children inherit it instead of importing it each."""
     from zonegraph.batch import BatchJob, Column
@@ -187,7 +190,7 @@ def _infer_job(config: InferConfig, timeout: float) -> BatchJob:
     guide_factory(config.guide)
 
     def run(target: Path, out: Path) -> Outcome:
-        return run_isolated(infer, (str(target), str(out), config), timeout=timeout)
+        return run_isolated(infer, (str(target), str(out), config), timeout=timeout, memory_mb=memory_mb)
 
     def values(r: InferResult) -> dict[str, Any]:
         return {
@@ -213,7 +216,7 @@ def _cmd_infer(args: argparse.Namespace) -> int:
         print(f"zonegraph: error: {error}", file=sys.stderr)
         return EXIT_USER_ERROR
     timeout = args.timeout or 3 * args.budget_s + 300  # the build and the export are not budgeted
-    job = partial(_infer_job, config, timeout)
+    job = partial(_infer_job, config, timeout, args.memory)
     status = _batch(job, args)
     if status is not None:
         return status
@@ -256,7 +259,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     rows: list[dict[str, Any]] = []
 
     def run(scratch: Path) -> Outcome:
-        rows.extend(_convert_into(batches, scratch, args.timeout))
+        rows.extend(_convert_into(batches, scratch, args.timeout, args.memory))
         summary = _convert_summary(rows)
         (scratch / "summary.json").write_text(summary)
         converted = any(row["status"] == Status.OK for row in rows)
@@ -267,6 +270,8 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     if not outcome.ok:  # the failed rows still say why, as a failed part's error.json does
         write_record(out, "summary.json", outcome.value)
     counts = json.loads(outcome.value)["counts"]
+    if not rows:
+        print(f"zonegraph: error: {args.source}: no def model_*() function in its batches", file=sys.stderr)
     for row in rows:
         if row.get("traceback"):
             print(row["traceback"], file=sys.stderr, end="")
@@ -290,7 +295,9 @@ def _convert_batches(source: Path) -> list[Path]:
     return batches
 
 
-def _convert_into(batches: list[Path], out: Path, timeout: float) -> list[dict[str, Any]]:
+def _convert_into(
+    batches: list[Path], out: Path, timeout: float, memory_mb: int | None = None
+) -> list[dict[str, Any]]:
     """A row per design, each converted in its own child (the batch is listed without running it,
     so a model's ``os._exit`` or endless loop stops only that design); its JSON written when ok."""
     from zonegraph.data.b123d import batch_entries
@@ -302,7 +309,7 @@ def _convert_into(batches: list[Path], out: Path, timeout: float) -> list[dict[s
         entries = batch_entries(batch, batch.parent.name)
         ok = 0
         for e in entries:
-            r = convert_isolated(batch, e.design_id, e.fusion_volume, e.fusion_area, timeout)
+            r = convert_isolated(batch, e.design_id, e.fusion_volume, e.fusion_area, timeout, memory_mb)
             if r.ok and r.design_json is not None:
                 (out / f"{r.design_id}.json").write_text(json.dumps(r.design_json))
                 ok += 1
@@ -422,6 +429,7 @@ def _add_infer(sub: Any) -> None:
         default=None,
         help="hard stop per part in seconds (default: 3 x budget + 300)",
     )
+    _add_memory(p)
     p.set_defaults(func=_cmd_infer)
 
 
@@ -436,6 +444,7 @@ def _add_build(sub: Any) -> None:
     p.add_argument("--samples", type=int, default=b["samples"], help="surface samples per zone")
     p.add_argument("--seed", type=int, default=b["seed"], help="seed of the surface samples")
     p.add_argument("--timeout", type=float, default=600.0, help="seconds before a build is stopped")
+    _add_memory(p)
     p.set_defaults(func=_cmd_build)
 
 
@@ -451,6 +460,7 @@ def _add_replay(sub: Any) -> None:
         help="largest relative volume and area error against the file's properties (else exit 2)",
     )
     p.add_argument("--no-check", action="store_true", help="keep the result whatever the file's properties")
+    _add_memory(p)
     p.set_defaults(func=_cmd_replay)
 
 
@@ -461,7 +471,19 @@ def _add_convert(sub: Any) -> None:
     p.add_argument(
         "--timeout", type=float, default=120.0, help="seconds per design (each runs in its own process)"
     )
+    _add_memory(p)
     p.set_defaults(func=_cmd_convert)
+
+
+def _add_memory(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--memory",
+        type=int,
+        default=None,
+        metavar="MIB",
+        help="address space each part's child may add, in MiB; past it the part is out_of_memory "
+        "(default: $ZONEGRAPH_MEMORY_MB, else no limit)",
+    )
 
 
 # Arguments that must be positive where a command has them (0 or less ran a search of no steps).
@@ -471,6 +493,7 @@ POSITIVE = {
     "k": "--k",
     "max_depth": "--max-depth",
     "tolerance": "--tolerance",
+    "memory": "--memory",
 }
 
 

@@ -14,6 +14,7 @@ past the limit is the ``out_of_memory`` status.
 from __future__ import annotations
 
 import ctypes
+import errno
 import gc
 import multiprocessing as mp
 import os
@@ -54,7 +55,7 @@ def classify(exc: BaseException) -> tuple[Status, str, str]:
     of ours and keeps its traceback."""
     if isinstance(exc, ZoneGraphError):
         return exc.status, exc.explain(), ""
-    if isinstance(exc, MemoryError) or "OutOfMemory" in type(exc).__name__:
+    if _out_of_memory(exc):
         return Status.OUT_OF_MEMORY, f"out of memory ({type(exc).__name__}) under the job's memory limit", ""
     last = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
     where = f" ({os.path.basename(last.filename)}:{last.lineno} {last.name})" if last else ""
@@ -63,6 +64,16 @@ def classify(exc: BaseException) -> tuple[Status, str, str]:
     if is_kernel_error(exc):
         return Status.KERNEL_ERROR, f"OpenCASCADE {name}: {message}{where}", ""
     return Status.BUG, f"{name}: {message}{where}", "".join(traceback.format_exception(exc))
+
+
+def _out_of_memory(exc: BaseException) -> bool:
+    """An allocation refused: Python's or OpenCASCADE's, or a mapping the address-space limit
+    denied (a shared library imported in the child: ``failed to map segment``; ``ENOMEM``)."""
+    if isinstance(exc, MemoryError) or "OutOfMemory" in type(exc).__name__:
+        return True
+    if isinstance(exc, OSError) and exc.errno == errno.ENOMEM:
+        return True
+    return isinstance(exc, ImportError) and "failed to map segment" in str(exc)
 
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
@@ -109,6 +120,8 @@ def _child(
             conn.send((Status.OK, fn(*args), "", ""))
     except BaseException as exc:  # noqa: BLE001 - every outcome, bugs included, goes to the parent
         status, reason, detail = classify(exc)
+        if status == Status.OUT_OF_MEMORY and memory_mb:
+            reason = f"out of memory ({type(exc).__name__}) past the {memory_mb} MiB memory limit"
         conn.send((status, None, reason, detail))
     finally:
         conn.close()
@@ -155,7 +168,7 @@ def _died(exitcode: int | None, memory_mb: int | None, seconds: float) -> Outcom
     (which aborts, SIGABRT, when an address-space limit refused it)."""
     if memory_mb and exitcode == -signal.SIGABRT:
         return Outcome(
-            Status.OUT_OF_MEMORY, reason=f"aborted under the {memory_mb} MiB memory limit", seconds=seconds
+            Status.OUT_OF_MEMORY, reason=f"aborted past the {memory_mb} MiB memory limit", seconds=seconds
         )
     if exitcode is not None and exitcode < 0:
         name = signal.Signals(-exitcode).name if -exitcode in signal.valid_signals() else str(-exitcode)

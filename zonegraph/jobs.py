@@ -185,14 +185,16 @@ def convert_isolated(
     fusion_volume: float | None = None,
     fusion_area: float | None = None,
     timeout: float = 120.0,
+    memory_mb: int | None = None,
 ) -> ConvertedDesign:
-    """:func:`convert_design` in a forked child killed after ``timeout`` seconds: the design's
-    endless C call, ``os._exit`` or segfault becomes a ``timeout`` or ``crash`` row, and a bug of
-    ours a ``bug`` row (its traceback the first of its ``notes``)."""
+    """:func:`convert_design` in a forked child killed after ``timeout`` seconds and allowed
+    ``memory_mb`` more MiB: the design's endless C call, ``os._exit``, segfault or unbounded
+    allocation becomes a ``timeout``, ``crash`` or ``out_of_memory`` row, and a bug of ours a
+    ``bug`` row (its traceback the first of its ``notes``)."""
     from zonegraph.data.b123d import ConvertedDesign, convert_design
 
     args = (str(batch_path), design_id, fusion_volume, fusion_area)
-    outcome = run_isolated(convert_design, args, timeout=timeout)
+    outcome = run_isolated(convert_design, args, timeout=timeout, memory_mb=memory_mb)
     if outcome.ok:
         converted: ConvertedDesign = outcome.value
         return converted

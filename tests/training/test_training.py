@@ -95,6 +95,48 @@ def test_both_fusions_score_and_eval_scores_do_not_depend_on_the_batch(labelled)
         assert torch.allclose(together[0], alone[0], atol=1e-5)
 
 
+@requires_samples
+def test_training_reads_only_the_shards_the_labels_records_list_as_ok_and_intact(labelled, tmp_path):
+    import shutil
+
+    from pipelines.records import hash_output
+    from training.shards import label_shards
+
+    labels = tmp_path / "labels"
+    shutil.copytree(labelled / "labels", labels)
+    ok, damaged, failed = (name.split(".")[0] for name in SAMPLES)
+    shards = {d: [labels / k / f"{d}.parquet" for k in ("proposals", "steps")] for d in (ok, damaged, failed)}
+    (labels / "records").mkdir()
+    for d, status in ((ok, "ok"), (damaged, "ok"), (failed, "timeout")):
+        record = {"design_id": d, "status": status, "outputs": [hash_output(p) for p in shards[d]]}
+        (labels / "records" / f"{d}.json").write_text(json.dumps(record))
+    steps = shards[damaged][1]
+    steps.write_bytes(steps.read_bytes()[: steps.stat().st_size // 2])  # a half-written shard
+    for kind in ("proposals", "steps"):  # a stray shard of an earlier run, without a record
+        shutil.copy(labels / kind / f"{ok}.parquet", labels / kind / "stray.parquet")
+    with pytest.warns(UserWarning, match="6 label shards left out"):
+        found = label_shards(labels)
+    assert found.design_ids == [ok]
+    assert (
+        found.left_out[f"steps/{damaged}.parquet"]
+        == f"steps/{damaged}.parquet differs from its record (size or SHA-1)"
+    )
+    assert found.left_out[f"proposals/{failed}.parquet"] == "its record is not ok (timeout)"
+    assert found.left_out["steps/stray.parquet"] == "no readable record in records/"
+    with pytest.warns(UserWarning):
+        data = LabelDataset(labels, labelled / "graphs", mode="rank", points_per_zone=16)
+    assert {s.design_id for s in data.states} == {ok}
+
+    shutil.rmtree(labels / "records")  # shards written without the stage: each must read
+    with pytest.warns(UserWarning, match="2 label shards left out"):
+        found = label_shards(labels)
+    assert found.design_ids == sorted([ok, failed, "stray"])
+    assert (
+        found.left_out[f"steps/{damaged}.parquet"]
+        == f"steps/{damaged}.parquet is not a readable Parquet file"
+    )
+
+
 @pytest.mark.slow
 @requires_samples
 def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_path, monkeypatch, samples_dir):

@@ -4,8 +4,9 @@ Shared by ``bench/fuzz_bench.py`` (1,000 inputs), ``tests/test_fuzz.py`` (a fast
 pipeline's fuzz test (``tests/pipelines/test_fuzz_stages.py``), so that there is one definition
 of the inputs and of the contract:
 
-- Inputs: the real design JSON of ``../shared/data/fusion360_samples`` and STEP files made by
-  replaying them, each with one mutation drawn by a Hypothesis strategy (seeded, derandomized).
+- Inputs: the real design JSON of ``../shared/data/fusion360_samples``, STEP files made by
+  replaying them, and one-model batches of the build123d corpus (``zonegraph convert``'s input),
+  each with one mutation drawn by a Hypothesis strategy (seeded, derandomized).
 - Runner: ``zonegraph.cli.main`` in a forked child of this (fresh) process, its fds 1 and 2
   redirected to files, so that OpenCASCADE's C-level prints are seen too. A fork, not an alarm:
   a hang inside C code (or a dead lock in the CLI parent) never returns to the interpreter, so a
@@ -38,7 +39,8 @@ from typing import Any, TypeVar
 from hypothesis import HealthCheck, Phase, given, seed, settings
 from hypothesis import strategies as st
 
-from zonegraph.testing.locations import SAMPLES, SKIP_REASON
+from zonegraph.outputs import LISTING
+from zonegraph.testing.locations import CORPUS, SAMPLES, SKIP_REASON
 
 __all__ = [
     "GOOD",
@@ -75,13 +77,16 @@ COMPLETE = {
         "zones.ply",
     ),
     "infer": ("result.json",),
+    "convert": ("summary.json",),
 }
 # The command's own stdout lines on success; anything else on stdout or stderr is noise.
 OWN_LINES = {
     "replay": (r"\S.*: \d+ extrudes?, \d+ bod(y|ies), ", r"  vs the file's properties: "),
     "build": (r"\S.*: status \w+, \d+ zones? ", r"  built in "),
-    "infer": (r"\S.*: \w+, \d+ steps? ", r"  \d+ zones?, build ", r"  why: "),
+    "infer": (r"\S.*: \w+, (\d+ steps? |no step, )", r"  \d+ zones?, build ", r"  why: "),
+    "convert": (r"\S+: \d+/\d+ converted$", r"converted \d+ of \d+ designs -> "),
 }
+CONVERT_ROW = re.compile(r"zonegraph: \S.*: \w+: (\w+): \S")  # a design's row: batch, id, status, reason
 ERROR_PREFIX = "zonegraph: error:"
 INTERNAL = re.compile(r"\(\w+\.py:\d+\)")  # an exception's file:line passed off as a user error
 KERNEL = re.compile(r"\*\*\*\*|warning", re.IGNORECASE)  # OpenCASCADE's messages, Python's warnings
@@ -404,10 +409,120 @@ def apply_step(m: dict[str, Any], text: bytes) -> bytes:
     return b"\n".join(lines)
 
 
+# Small designs of the corpus's first batch (none of them in a held-out sample), each cut out as
+# a batch of its own: ``convert`` of a whole 166-model batch would cost minutes per input.
+CORPUS_MODELS = (
+    "100243_9fb796fe_0005",
+    "100243_9fb796fe_0006",
+    "100877_ac1e5a17_0001",
+    "100877_ac1e5a17_0017",
+    "101427_a9bcb09c_0002",
+)
+# Statements put first in a model's body: what a hostile or broken script does.
+HOSTILE = (
+    "while True: pass",
+    "import os; os._exit(0)",
+    "import sys; sys.exit(3)",
+    "raise SystemExit",
+    "import os, signal; os.kill(os.getpid(), signal.SIGSEGV)",
+    "hoard = [bytes(64 << 20) for _ in iter(int, 1)]",
+    "return None",
+    "return 42",
+    "1 / 0",
+    "raise KeyboardInterrupt",
+    "import sys; sys.setrecursionlimit(10**6); f = lambda: f(); f()",
+)
+SCRIPT_TOKENS = ("1e300", "-1e300", "0", "1e-300", "float('nan')", "float('inf')", "-1", "'x'", "None")
+CONVERT_MEMORY_MB = 1024  # a model that allocates without bound stops here (out_of_memory)
+
+
+@cache
+def script_texts() -> dict[str, bytes]:
+    """One batch file per :data:`CORPUS_MODELS` design: the batch's imports, the model's function
+    and its ``MODELS`` entry (Fusion's volume and area); empty without the corpus."""
+    batch = CORPUS / "01_2ops" / "batch_001.py"
+    if not batch.is_file():
+        return {}
+    text = batch.read_text(encoding="utf-8")
+    header = text[: text.index("\ndef model_")]
+    out = {}
+    for design_id in CORPUS_MODELS:
+        start = text.index(f"\ndef model_{design_id}()")
+        end = re.compile(r"\n(# Description|def |MODELS)").search(text, start + 1)
+        entry = next(line for line in text.splitlines() if line.lstrip().startswith(f'"model_{design_id}"'))
+        body = text[start : end.start() if end else len(text)]
+        out[design_id] = f"{header}\n{body}\n\nMODELS = {{\n{entry}\n}}\n".encode()
+    return out
+
+
 @st.composite
-def fuzz_cases(draw: st.DrawFn, steps: dict[str, bytes]) -> Case:
+def script_mutations(draw: st.DrawFn) -> dict[str, Any]:
+    """One mutation of a one-model batch: bytes or lines damaged, a number made absurd, a hostile
+    statement first in the model, random bytes, or nothing at all."""
+    name = draw(st.sampled_from(sorted(script_texts())))
+    text = script_texts()[name]
+    op = draw(
+        st.sampled_from(
+            (
+                "hostile",
+                "hostile",
+                "truncate",
+                "flip",
+                "insert",
+                "drop_line",
+                "dup_line",
+                "number",
+                "garbage",
+                "empty",
+            )
+        )
+    )
+    m: dict[str, Any] = {"op": op, "model": name}
+    if op in ("truncate", "flip", "insert"):
+        m["at"] = draw(st.integers(0, len(text) - 1))
+    if op == "flip":
+        m["xor"] = draw(st.integers(1, 255))
+    if op == "insert":
+        m["bytes"] = draw(st.binary(min_size=1, max_size=16)).hex()
+    if op in ("drop_line", "dup_line"):
+        m["line"] = draw(st.integers(0, text.count(b"\n")))
+    if op == "number":
+        m["nth"] = draw(st.integers(0, 200))
+        m["token"] = draw(spread(SCRIPT_TOKENS, name))
+    if op == "hostile":
+        m["statement"] = draw(spread(HOSTILE, name))
+    if op == "garbage":
+        m["bytes"] = draw(st.binary(min_size=1, max_size=200)).hex()
+    return m
+
+
+SCRIPT_NUMBER = re.compile(rb"(?<![\w.])-?\d+(?:\.\d+)?")
+
+
+def apply_script(m: dict[str, Any]) -> bytes:
+    """The mutated batch file's bytes."""
+    op, text = m["op"], script_texts()[m["model"]]
+    if op in ("empty", "garbage"):
+        return bytes.fromhex(m.get("bytes", ""))
+    if op == "hostile":
+        head = f"def model_{m['model']}():\n".encode()
+        at = text.index(head) + len(head)
+        return text[:at] + f"    {m['statement']}\n".encode() + text[at:]
+    if op == "number":
+        found = list(SCRIPT_NUMBER.finditer(text))
+        hit = found[m["nth"] % len(found)]
+        return text[: hit.start()] + m["token"].encode() + text[hit.end() :]
+    return apply_step(m, text)  # the byte and line edits are the STEP file's
+
+
+@st.composite
+def fuzz_cases(draw: st.DrawFn, steps: dict[str, bytes], scripts: bool = False) -> Case:
     """A command on a mutated design JSON (replay, build, infer; two draws in three) or on a mutated
-    STEP file (build, infer)."""
+    STEP file (build, infer); with ``scripts``, ``convert`` of a mutated batch when an integer in
+    0..4 draws 0 (more often than one in five: Hypothesis favours 0)."""
+    if scripts and script_texts() and not draw(st.integers(0, 4)):
+        m = draw(script_mutations())
+        return Case("convert", "script", m["model"], m)
     if not steps or draw(st.integers(0, 2)):
         m = draw(json_mutations())
         return Case(draw(st.sampled_from(("replay", "build", "infer"))), "json", m["design"], m)
@@ -470,6 +585,8 @@ def warm_up() -> None:
     """Import what the commands import lazily, once, here: every forked child inherits it instead
     of importing the kernel again. Nothing here runs geometry (this process must never run an
     OpenCASCADE Boolean: forking after a threaded Boolean can hang a child)."""
+    import build123d  # noqa: F401 - convert's parent imports it for its children
+
     import zonegraph.batch  # noqa: F401
     import zonegraph.isolation  # noqa: F401
     import zonegraph.jobs  # noqa: F401
@@ -481,6 +598,8 @@ def warm_up() -> None:
 
 def argv_for(command: str, target: Path, out: Path, timeout: float) -> list[str]:
     argv = [command, str(target), "--out", str(out), "--timeout", f"{timeout:g}"]
+    if command == "convert":
+        return argv + ["--memory", str(CONVERT_MEMORY_MB)]
     return argv + ["--budget", f"{BUDGET_S:g}"] if command == "infer" else argv
 
 
@@ -553,13 +672,18 @@ def run_case(
 ) -> Row:
     """Write the mutated input, run its command on a fresh ``--out`` in a fresh parent folder, and
     classify it; ``keep`` receives the input file of a violation (to reproduce it)."""
-    data = apply_json(case.mutation) if case.kind == "json" else apply_step(case.mutation, steps[case.source])
+    if case.kind == "script":
+        data = apply_script(case.mutation)
+    elif case.kind == "json":
+        data = apply_json(case.mutation)
+    else:
+        data = apply_step(case.mutation, steps[case.source])
     work = Path(tempfile.mkdtemp(prefix="zg-fuzz-"))
     try:
         io, parent = work / "io", work / "parent"
         io.mkdir()
         parent.mkdir()
-        target = io / ("design.json" if case.kind == "json" else "part.step")
+        target = io / {"json": "design.json", "step": "part.step", "script": "batch_001.py"}[case.kind]
         target.write_bytes(data)
         out = parent / "out"
         row = Row(
@@ -594,6 +718,11 @@ def classify(row: Row, result: dict[str, Any] | None, parent: Path, out: Path) -
     row.exit = result.get("rc") if result else None
     err = row.stderr.splitlines()
     errors = [line for line in err if line.startswith(ERROR_PREFIX)]
+    if row.command == "convert":  # its one line per failed design stands for the error line
+        errors = errors or [f"{ERROR_PREFIX} {line[11:]}" for line in err if CONVERT_ROW.match(line)][:1]
+        err = [line for line in err if not CONVERT_ROW.match(line) or INTERNAL.search(line)]
+        if errors and not any(line.startswith(ERROR_PREFIX) for line in err):
+            err.append(errors[0])
     found: dict[str, str] = {}
     broken = _broken(row, result, err, errors)
     if broken:
@@ -639,8 +768,10 @@ def _noise(row: Row, err: list[str], errors: list[str], broken: bool) -> str:
     """The first line that is not the command's own: its summary lines on success, its one error
     line on failure (after a traceback, only the lines that look like kernel or warning output)."""
     out = row.stdout.splitlines()
+    own = [re.compile(p) for p in OWN_LINES[row.command]]
+    if row.command == "convert":  # its progress and summary lines come whatever the outcome
+        out = [line for line in out if not any(p.match(line) for p in own)]
     if row.exit == 0 and not broken:
-        own = [re.compile(p) for p in OWN_LINES[row.command]]
         stray = [line for line in out if not any(p.match(line) for p in own)] + err
     elif broken:
         stray = out + [line for line in err if KERNEL.search(line)]
@@ -658,8 +789,12 @@ def _leftovers(row: Row, parent: Path, out: Path) -> str:
         row.left = beside
         return f"left beside --out: {', '.join(beside[:5])}"
     if row.exit != 0:
+        if row.command == "convert":  # a failed convert's summary says why each design failed
+            inside = [name for name in inside if name not in ("summary.json", LISTING)]
         row.left = inside
         return f"a failed run left in --out: {', '.join(inside[:5])}" if inside else ""
+    if row.command == "convert" and not any(p.name != "summary.json" for p in out.glob("*.json")):
+        return "success without a converted design's JSON"
     missing = [f for f in COMPLETE[row.command] if not (out / f).is_file() or not (out / f).stat().st_size]
     return f"success without {', '.join(missing)}" if missing else ""
 
@@ -692,7 +827,7 @@ def fuzz(
     warm_up()
     with tempfile.TemporaryDirectory(prefix="zg-fuzz-steps-") as folder:
         steps = make_steps(Path(folder), timeout)
-    cases = draw_cases(count, seed_value, fuzz_cases(steps))
+    cases = draw_cases(count, seed_value, fuzz_cases(steps, scripts=True))
     rows: list[Row] = []
     for i, case in enumerate(cases):
         rows.append(run_case(case, i, steps, timeout, keep))

@@ -118,7 +118,9 @@ def _convert(  # noqa: C901 - the steps of one conversion, in order
     try:
         with recording() as calls:
             part = func()
-    except (Exception, SystemExit) as exc:  # whatever the script raises, sys.exit included
+    except MemoryError:
+        raise  # the memory limit's outcome (out_of_memory, zonegraph.isolation), not the model's
+    except (Exception, SystemExit, KeyboardInterrupt) as exc:  # whatever the script raises, sys.exit too
         return result(Status.MODEL_RAISED, f"{type(exc).__name__}: {one_line(exc)}")
     if not isinstance(part, Shape) or part.wrapped is None or not part.solids():
         return result(Status.NO_SHAPE, f"the model returned {type(part).__name__} without a solid")
