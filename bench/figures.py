@@ -3,7 +3,7 @@
     python -m bench.figures corpus NAME RESULTS.json --command "python -m bench.corpus_bench ..." \
         [--commit SHA] [--out docs/figures]
     python -m bench.figures fusion-diff NAME RESULTS.json --command "..." [--commit SHA]
-    python -m bench.figures conversion NAME data/metrics/conversion_details.json --command "..."
+    python -m bench.figures conversion NAME data/details/conversion.json --command "..."
     python -m bench.figures fuzz NAME DIR/rows.json --command "python -m bench.fuzz_bench ..."
     python -m bench.figures verify NAME DIR/results.json --command "python -m bench.verify_bench ..."
 
@@ -72,7 +72,7 @@ def corpus_figure(rows: list[dict]) -> dict:
 
 def conversion_figure(details: dict) -> dict:
     """The corpus conversion by folder and its failures by status, from the generate stage's
-    ``conversion_details.json`` (or a metrics file of before, which held the same keys)."""
+    ``data/details/conversion.json`` (or a metrics file of before, which held the same keys)."""
     by_folder = {
         f: {"designs": g["designs"], "converted": g["converted"]} for f, g in details["by_folder"].items()
     }

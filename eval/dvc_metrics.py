@@ -5,8 +5,9 @@ own flat or nested keys widens every row by a column that is a dash for all the 
 (before this, 82 columns). Each stage's file in ``data/metrics/`` (one per guide for ``evaluate``
 and ``reconstruct``) therefore holds only :data:`SHARED`, plus a stage's one or two headline
 figures from :data:`HEADLINE`; its breakdowns (by status, by folder, by coverage category, the
-runner's retries) go to a ``*_details.json`` beside it, declared in ``dvc.yaml`` as a plain
-output, not as a metric. ``docs/pipeline.md`` lists which key went where.
+runner's retries) go to ``data/details/<stage>.json``, declared in ``dvc.yaml`` as a plain
+output, not as a metric, and outside ``data/metrics`` so that ``dvc metrics show data/metrics``
+shows the metrics alone. ``docs/pipeline.md`` lists which key went where.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 SHARED = ("designs", "ok", "failed", "seconds")  # seconds: the median per design
-HEADLINE = ("captured", "exact", "iou", "rank")  # rates in [0, 1]; only where a stage measures them
+HEADLINE = ("exact", "iou", "rank")  # in [0, 1], per guide; each more key is a column of every row
 DIGITS = 3  # three decimals keep a column 5 characters wide; the details keep every digit
 
 

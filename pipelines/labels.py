@@ -9,7 +9,7 @@ killable Dask task that writes its own shards, ``data/labels/proposals/<id>.parq
 ``data/labels/steps/<id>.parquet`` (schemas in docs/pipeline.md; read the folders with
 ``pyarrow.dataset``), so one bad design never loses the others and an interrupted run resumes.
 ``data/metrics/labels.json`` has the shared metrics keys (every design, training and rank-only);
-``labels_details.json`` beside it counts designs, steps and labels (rank-only designs apart).
+``data/details/labels.json`` counts designs, steps and labels (rank-only designs apart).
 """
 
 from __future__ import annotations

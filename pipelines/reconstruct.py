@@ -6,7 +6,7 @@ stage saved (zone-graph build time is excluded from the budget, as in the paper)
 ``data/reconstruct/results.parquet`` (one row per design and guide), each program under
 ``data/reconstruct/<guide>/<id>/`` and the metrics
 (exact rate, mean B-rep IoU per guide) in ``data/metrics/reconstruct/<guide>.json``, with the median
-time to exact and the failures in ``reconstruct_details.json``.
+time to exact and the failures in ``data/details/reconstruct.json``.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from pipelines import generate, reconstruct, replay, zonegraphs
 
 def write_small_metrics(root: Path) -> None:
     """Each stage's metrics and details from a few designs' rows, as the stages write them."""
-    m = root / "data/metrics"
+    m, d = root / "data/metrics", root / "data/details"
     statuses = ["ok", "ok", "ok", "convert_timeout"]
     conversion = pd.DataFrame(
         {
@@ -29,7 +29,7 @@ def write_small_metrics(root: Path) -> None:
     )
     (root / "designs").mkdir(parents=True, exist_ok=True)
     generate.write_conversion(
-        conversion, root / "designs", m / "conversion.json", m / "conversion_details.json"
+        conversion, root / "designs", m / "conversion.json", d / "conversion.json"
     )
     manifest = pd.DataFrame(
         {
@@ -43,8 +43,8 @@ def write_small_metrics(root: Path) -> None:
             "zones": [8, 12, None],
         }
     )
-    replay.write_metrics(manifest, {"retry_limit": 3}, m / "replay.json", m / "replay_details.json")
-    zonegraphs.write_metrics(manifest, m / "zonegraphs.json", m / "zonegraphs_details.json")
+    replay.write_metrics(manifest, {"retry_limit": 3}, m / "replay.json", d / "replay.json")
+    zonegraphs.write_metrics(manifest, m / "zonegraphs.json", d / "zonegraphs.json")
     results = pd.DataFrame(
         {
             "design_id": ["a", "b", "a", "b"],
@@ -57,7 +57,7 @@ def write_small_metrics(root: Path) -> None:
         }
     )
     reconstruct.write_metrics(
-        reconstruct.summarise(results), m / "reconstruct", m / "reconstruct_details.json"
+        reconstruct.summarise(results), m / "reconstruct", d / "reconstruct.json"
     )
 
 
@@ -67,16 +67,15 @@ def _read(path: Path) -> dict:
 
 def test_every_metrics_file_has_the_shared_keys_and_no_others(tmp_path):
     write_small_metrics(tmp_path)
-    m = tmp_path / "data/metrics"
-    files = [*m.glob("*.json"), *m.glob("*/*.json")]
-    metrics = [f for f in files if not f.name.endswith("_details.json")]
+    m, d = tmp_path / "data/metrics", tmp_path / "data/details"
+    metrics = [*m.glob("*.json"), *m.glob("*/*.json")]  # dvc metrics show data/metrics: these only
     assert {f.stem for f in metrics} == {"conversion", "replay", "zonegraphs", "heuristic", "random"}
     for f in metrics:
         assert set(SHARED) <= set(_read(f)) <= {*SHARED, *HEADLINE}, f
     assert _read(m / "conversion.json") == {"designs": 4, "ok": 3, "failed": 1, "seconds": 2.5}
-    assert _read(m / "conversion_details.json")["by_folder"]["02_3ops"] == {"designs": 2, "converted": 1}
-    assert _read(m / "replay_details.json")["failed_by_status"] == {"replay_failed": 1}
-    assert _read(m / "zonegraphs_details.json")["median_zones"] == 10.0
+    assert _read(d / "conversion.json")["by_folder"]["02_3ops"] == {"designs": 2, "converted": 1}
+    assert _read(d / "replay.json")["failed_by_status"] == {"replay_failed": 1}
+    assert _read(d / "zonegraphs.json")["median_zones"] == 10.0
     # The exact rate and mean IoU count every design of the guide, the failed searches as 0.
     assert _read(m / "reconstruct/heuristic.json") == {
         "designs": 2,
@@ -87,7 +86,7 @@ def test_every_metrics_file_has_the_shared_keys_and_no_others(tmp_path):
         "iou": 0.75,
     }
     assert _read(m / "reconstruct/random.json")["failed"] == 1
-    assert _read(m / "reconstruct_details.json")["random"]["failures"] == {"timeout": 1}
+    assert _read(d / "reconstruct.json")["random"]["failures"] == {"timeout": 1}
 
 
 def test_a_guide_no_longer_run_loses_its_file(tmp_path):
