@@ -28,9 +28,7 @@ def write_small_metrics(root: Path) -> None:
         }
     )
     (root / "designs").mkdir(parents=True, exist_ok=True)
-    generate.write_conversion(
-        conversion, root / "designs", m / "conversion.json", d / "conversion.json"
-    )
+    generate.write_conversion(conversion, root / "designs", m / "conversion.json", d / "conversion.json")
     manifest = pd.DataFrame(
         {
             "design_id": list("abc"),
@@ -56,9 +54,7 @@ def write_small_metrics(root: Path) -> None:
             "seconds": [1.0, 2.0, 2.0, 60.0],
         }
     )
-    reconstruct.write_metrics(
-        reconstruct.summarise(results), m / "reconstruct", d / "reconstruct.json"
-    )
+    reconstruct.write_metrics(reconstruct.summarise(results), m / "reconstruct", d / "reconstruct.json")
 
 
 def _read(path: Path) -> dict:
