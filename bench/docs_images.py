@@ -1,17 +1,25 @@
 """The pictures of the documentation, made from a part built here (no data set geometry).
 
     python -m bench.docs_images [--out docs/images]
+    python -m bench.docs_images --mlflow PROJECT [--out docs/images]
 
 A bracket (a plate with a slot and a bored boss) is built with build123d and written as STEP;
 ``zonegraph.infer`` runs on it as ``zonegraph infer bracket.step`` would, and its strip
 (``sequence.png``), its editable script (``bracket_sequence.py``) and a picture of its zone graph
 (``zones.png``) are copied into ``--out``. Re-run it when the renderer or the writer changes.
+
+``--mlflow PROJECT`` instead photographs the MLflow dashboard of a project that trained (and
+evaluated): ``mlflow ui`` on its ``mlflow.db``, as ``make ui`` serves it, opened in headless
+Chromium at the experiments list, the newest training run, its metrics, its logged model and the
+newest evaluation run with its metrics (``mlflow_*.png``, palette-reduced to stay small).
 """
 
 from __future__ import annotations
 
 import argparse
 import shutil
+import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -32,6 +40,7 @@ from build123d import (
 
 import zonegraph as zg
 from zonegraph.export.render import render_zone_graph
+from zonegraph.testing.mlflow_server import free_port, rest
 
 
 def bracket(path: Path) -> Path:
@@ -51,11 +60,97 @@ def bracket(path: Path) -> Path:
     return path
 
 
+WIDTH = 1400
+SHOTS = {  # file -> the dashboard's address (from the experiment and run ids) and the shot's height
+    "mlflow_experiments.png": ("#/experiments/{train}/runs", 500),
+    "mlflow_training_run.png": ("#/experiments/{train}/runs/{run}", 1100),
+    "mlflow_training_metrics.png": ("#/experiments/{train}/runs/{run}/model-metrics", 1900),
+    "mlflow_logged_model.png": ("#/experiments/{train}/models/{model}", 900),
+    "mlflow_evaluation_overview.png": ("#/experiments/{evaluation}/runs/{eval_run}", 1100),
+    "mlflow_evaluation_run.png": ("#/experiments/{evaluation}/runs/{eval_run}/model-metrics", 1500),
+}
+
+
+def _newest_run(url: str, experiment_id: str) -> dict:
+    body = {"experiment_ids": [experiment_id], "max_results": 1, "order_by": ["start_time DESC"]}
+    return rest(url, "runs/search", body)["runs"][0]
+
+
+def _ids(url: str) -> dict[str, str]:
+    """The experiments and newest runs the pictures show, and the training run's logged model;
+    an experiment the project has not run yet is left out."""
+    ids = {}
+    for key, run, name in (("train", "run", "zonegraph-scorer"), ("evaluation", "eval_run", "evaluation")):
+        try:
+            found = rest(url, f"experiments/get-by-name?experiment_name={name}", wait_s=0)["experiment"]
+        except OSError:
+            continue
+        ids[key] = found["experiment_id"]
+        ids[run] = _newest_run(url, ids[key])["info"]["run_id"]
+    if "run" in ids:
+        models = rest(url, "logged-models/search", {"experiment_ids": [ids["train"]]})["models"]
+        logged = [m["info"]["model_id"] for m in models if m["info"]["source_run_id"] == ids["run"]]
+        ids |= {"model": logged[0]} if logged else {}
+    return ids
+
+
+def _shoot(address: str, height: int, path: Path) -> None:
+    """One page in headless Chromium; the charts draw only with every compositor stage run."""
+    subprocess.run(
+        ["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars"]
+        + ["--run-all-compositor-stages-before-draw", "--virtual-time-budget=60000"]
+        + [f"--window-size={WIDTH},{height}", f"--screenshot={path}", address],
+        check=True,
+        capture_output=True,
+        timeout=180,
+    )
+    from PIL import Image
+
+    with Image.open(path) as image:  # a UI's few colours: a palette keeps a shot near 100 KB
+        small = image.convert("RGB").quantize(colors=64)
+    small.save(path, optimize=True)
+
+
+def mlflow_shots(project: Path, out: Path) -> list[Path]:
+    """Serve ``project``'s store with ``mlflow ui`` and photograph :data:`SHOTS` into ``out``."""
+    subprocess.run([sys.executable, "-m", "eval.tracking", "relocate"], cwd=project, check=True)
+    port = free_port()
+    server = subprocess.Popen(
+        [sys.executable, "-m", "mlflow", "ui", "--backend-store-uri", "sqlite:///mlflow.db"]
+        + ["--host", "127.0.0.1", "--port", str(port), "--workers", "1"],
+        cwd=project,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        base = f"http://127.0.0.1:{port}"
+        rest(base, "experiments/search", {"max_results": 1})  # the server is up
+        ids = _ids(base)
+        paths = []
+        for name, (address, height) in SHOTS.items():
+            try:
+                address = address.format(**ids)
+            except KeyError as missing:
+                print(f"{name}: skipped, the project has no {missing.args[0]} to show", flush=True)
+                continue
+            _shoot(f"{base}/{address}", height, out / name)
+            paths.append(out / name)
+            print(f"wrote {out / name} ({(out / name).stat().st_size // 1024} KB)", flush=True)
+        return paths
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=Path("docs/images"))
+    ap.add_argument("--mlflow", type=Path, default=None, help="photograph this project's MLflow runs instead")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
+    if args.mlflow is not None:
+        mlflow_shots(args.mlflow.resolve(), args.out.resolve())
+        return
     with tempfile.TemporaryDirectory() as work:
         step = bracket(Path(work) / "bracket.step")
         result = zg.infer(step, Path(work) / "out", zg.InferConfig(budget_s=10))

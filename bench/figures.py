@@ -3,6 +3,9 @@
     python -m bench.figures corpus NAME RESULTS.json --command "python -m bench.corpus_bench ..." \
         [--commit SHA] [--out docs/figures]
     python -m bench.figures fusion-diff NAME RESULTS.json --command "..." [--commit SHA]
+    python -m bench.figures conversion NAME data/details/conversion.json --command "..."
+    python -m bench.figures fuzz NAME DIR/rows.json --command "python -m bench.fuzz_bench ..."
+    python -m bench.figures verify NAME DIR/results.json --command "python -m bench.verify_bench ..."
 
 A results page never carries a number typed by hand: a benchmark's ``results.json`` (its per-design
 rows, or its summary) is reduced here to a small figure file, ``docs/figures/NAME.json``, holding
@@ -15,7 +18,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import subprocess
+from collections import Counter
 from datetime import date
 from pathlib import Path
 
@@ -26,6 +31,7 @@ from zonegraph.status import Status
 FIGURES = Path("docs/figures")
 EXACT_IOU = 0.9999
 SEARCHED = (Status.EXACT, Status.PARTIAL, Status.REBUILD_FAILED)
+USER_ERROR = re.compile(r"error: \S+: ([a-z_]+): ")
 
 
 def _group(rows: list[dict]) -> dict:
@@ -64,6 +70,77 @@ def corpus_figure(rows: list[dict]) -> dict:
     }
 
 
+def conversion_figure(details: dict) -> dict:
+    """The corpus conversion by folder and its failures by status, from the generate stage's
+    ``data/details/conversion.json`` (or a metrics file of before, which held the same keys)."""
+    by_folder = {
+        f: {"designs": g["designs"], "converted": g["converted"]} for f, g in details["by_folder"].items()
+    }
+    return {
+        "by_folder": by_folder,
+        "designs": sum(g["designs"] for g in by_folder.values()),
+        "converted": sum(g["converted"] for g in by_folder.values()),
+        "failed_by_status": {k: v for k, v in details["by_status"].items() if k != Status.OK},
+    }
+
+
+def fuzz_figure(rows: list[dict]) -> dict:
+    """The fuzz benchmark's outcomes by command, the user errors by status and the slowest input,
+    from its ``rows.json``."""
+    commands = sorted({r["command"] for r in rows})
+    outcomes = sorted({r["outcome"] for r in rows})
+    statuses: dict[str, int] = {}
+    for r in rows:
+        if r["outcome"] == "user_error":  # "zonegraph: error: PATH: STATUS: reason"
+            found = USER_ERROR.search(str(r.get("detail", "")))
+            key = found.group(1) if found else "other"
+            statuses[key] = statuses.get(key, 0) + 1
+    return {
+        "inputs": len(rows),
+        "by_outcome": {
+            o: {c: sum(r["outcome"] == o and r["command"] == c for r in rows) for c in commands}
+            for o in outcomes
+        },
+        "user_errors_by_status": dict(sorted(statuses.items(), key=lambda kv: -kv[1])),
+        "slowest_s": round(max((float(r["seconds"]) for r in rows), default=0.0), 2),
+    }
+
+
+def verify_figure(rows: list[dict]) -> dict:
+    """The verify benchmark's sample: conversions by status, replay exit codes, the differences
+    from Fusion by decade and every converted design above ``THRESHOLD``, from its results.json."""
+    from bench.verify_bench import THRESHOLD, decade
+
+    ok = [r for r in rows if r["status"] == Status.OK]
+    above = [
+        r
+        for r in ok
+        if max(r["fusion_volume_rel_difference"] or 0, r["fusion_area_rel_difference"] or 0) > THRESHOLD
+    ]
+    return {
+        "designs": len(rows),
+        "convert": dict(Counter(r["status"] for r in rows)),
+        "converted": len(ok),
+        "replay_exits": {str(k): v for k, v in Counter(r.get("replay_exit") for r in ok).items()},
+        "volume_decades": dict(Counter(decade(r["fusion_volume_rel_difference"]) for r in ok)),
+        "area_decades": dict(Counter(decade(r["fusion_area_rel_difference"]) for r in ok)),
+        "threshold": THRESHOLD,
+        "above": [
+            {k: r.get(k) for k in ("design_id", "batch", "replay_exit")}
+            | {"volume": r["fusion_volume_rel_difference"], "area": r["fusion_area_rel_difference"]}
+            for r in sorted(above, key=lambda r: -(r["fusion_volume_rel_difference"] or 0))
+        ],
+    }
+
+
+FIGURES_OF = {
+    "corpus": corpus_figure,
+    "conversion": conversion_figure,
+    "fuzz": fuzz_figure,
+    "verify": verify_figure,
+}
+
+
 def head_commit() -> str:
     out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     return out.stdout.strip() or "unknown"
@@ -88,7 +165,7 @@ def write_figure(
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("kind", choices=["corpus", "fusion-diff"])
+    ap.add_argument("kind", choices=[*FIGURES_OF, "fusion-diff"])
     ap.add_argument("name", help="the figure's file name under --out, without .json")
     ap.add_argument("results", type=Path, help="the benchmark's results.json")
     ap.add_argument("--command", required=True, help="the command that wrote RESULTS")
@@ -97,7 +174,7 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=FIGURES)
     args = ap.parse_args()
     data = json.loads(args.results.read_text())
-    figure = corpus_figure(data) if args.kind == "corpus" else data
+    figure = FIGURES_OF[args.kind](data) if args.kind in FIGURES_OF else data
     commit = args.commit or head_commit()
     path = write_figure(args.kind, args.name, figure, args.command, commit, args.measured, args.out)
     print(f"wrote {path}")

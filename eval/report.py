@@ -34,6 +34,7 @@ import pandas as pd
 
 import zonegraph.network
 from eval.curves import curves, plot_curves, time_grid
+from eval.dvc_metrics import rounded, write_guides
 from eval.heldout import held_out, held_out_labelled, trained_projects
 from eval.programs import program_measures
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, ranked, ratios, summarise
@@ -66,7 +67,7 @@ class EvalConfig(Config):
         project: the pipeline project to read data/ from.
         labels: the labels stage's folder.
         graphs: the zonegraphs stage's graphs.
-        metrics: also write the metrics JSON here (the DVC metrics file).
+        metrics: also write one metrics JSON per guide into this folder (the DVC metrics).
         plot_csv: also write mean IoU vs time (k 5) here, wide (the DVC plot).
     """
 
@@ -318,6 +319,24 @@ def metrics_of(rank: pd.DataFrame, curve_table: pd.DataFrame) -> dict[str, float
     return {k.replace(":", "_"): v for k, v in metrics.items()}
 
 
+def guide_metrics(rank: pd.DataFrame, curve_table: pd.DataFrame) -> dict[str, dict]:
+    """Per guide, the DVC metrics' headline: the designs searched at k 5, the exact rate and mean
+    IoU at the end of the budget and rank / P (the full set stays in ``metrics.json``)."""
+    by_guide: dict[str, dict] = {}
+    main = curve_table[curve_table["k"] == 5] if len(curve_table) else curve_table
+    for guide, group in main.groupby("guide", sort=False):
+        end = group.loc[group["seconds"].idxmax()]
+        by_guide[str(guide)] = {
+            "designs": int(end["designs"]),
+            "exact": rounded(float(end["exact_rate"])),
+            "iou": rounded(float(end["mean_iou"])),
+        }
+    for r in rank.to_dict(orient="records"):
+        if pd.notna(r.get("rank")):
+            by_guide.setdefault(str(r["guide"]), {})["rank"] = rounded(float(r["rank"]))
+    return by_guide
+
+
 def extras_section(args: argparse.Namespace, out: Path) -> str:
     """The coverage table and zone statistics the pipeline already made, copied beside the report."""
     project, text = Path(args.project), ""
@@ -367,7 +386,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--labels", default=d["labels"])
     parser.add_argument("--graphs", default=d["graphs"])
     parser.add_argument("--no-mlflow", action="store_true")
-    parser.add_argument("--metrics", default=d["metrics"], help="also write the metrics JSON here")
+    parser.add_argument(
+        "--metrics", default=d["metrics"], help="also write one metrics JSON per guide into this folder"
+    )
     parser.add_argument(
         "--plot-csv", default=d["plot_csv"], help="also write mean IoU vs time (k 5) here, wide"
     )
@@ -404,9 +425,8 @@ def main() -> None:
     (args.out / "report.md").write_text(report)
     metrics = metrics_of(rank, curve_table)
     (args.out / "metrics.json").write_text(json.dumps(metrics, indent=2))
-    if args.metrics:  # the DVC metrics file, outside the stage's output folder
-        Path(args.metrics).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy(args.out / "metrics.json", args.metrics)
+    if args.metrics:  # the DVC metrics, one file per guide, outside the stage's output folder
+        write_guides(Path(args.metrics), guide_metrics(rank, curve_table))
     if args.plot_csv and len(curve_table):  # one column per guide, for dvc plots
         main_curves = curve_table[curve_table["k"] == 5]
         wide = main_curves.pivot(index="seconds", columns="guide", values="mean_iou").reset_index()

@@ -47,7 +47,8 @@ def run_name(params: dict[str, Any]) -> str:
     designs = Path(str(params.get("designs", "test"))).name or "designs"
     k = params.get("k", "")
     widths = "-".join(str(x) for x in k) if isinstance(k, list | tuple) else str(k)
-    return f"evaluate {designs} {params.get('budget', '?')}s k{widths} seed{params.get('seed', 0)}"
+    budget = params.get("budget_s", params.get("budget", "?"))  # eval.report's name for --budget
+    return f"evaluate {designs} {budget}s k{widths} seed{params.get('seed', 0)}"
 
 
 def _description(models: Sequence[str | Path], runs: dict[str, str]) -> str:

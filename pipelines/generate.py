@@ -9,7 +9,8 @@
 ``data.limit`` keeps a seeded sample, stratified by timeline folder. Either way the stage writes
 ``data/designs/index.parquet`` (design id, path, split, folder: the timeline-length bucket),
 ``stats.json``/``stats.txt`` beside the published statistics and, for the corpus,
-``conversion.parquet`` (every design with its status and reason) and ``data/metrics/conversion.json``.
+``conversion.parquet`` (every design with its status and reason), ``data/metrics/conversion.json``
+(:mod:`eval.dvc_metrics`' shared keys) and its breakdowns in ``data/details/conversion.json``.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from typing import Any
 
 import pandas as pd
 
+from eval.dvc_metrics import headline, write_json
 from zonegraph.data.b123d import convert_design, list_corpus
 from zonegraph.data.dataset import DesignRecord, read_dataset, stratified_sample, test_ids
 from zonegraph.data.design import load_design
@@ -126,26 +128,22 @@ def convert_corpus(
     )
 
 
-def write_conversion(table: pd.DataFrame, out: Path, metrics_file: Path) -> None:
+def write_conversion(table: pd.DataFrame, out: Path, metrics_file: Path, details_file: Path) -> None:
     table.to_parquet(out / "conversion.parquet", index=False)
     ok = table["status"] == Status.OK
-    metrics = {
+    write_json(metrics_file, headline(len(table), int(ok.sum()), table["seconds"]))
+    details = {
         "source": "b123d",
-        "designs": int(len(table)),
-        "converted": int(ok.sum()),
-        "rate": float(ok.mean()) if len(table) else 0.0,
         "by_status": {k: int(v) for k, v in table["status"].value_counts().items()},
         "by_folder": {
             f: {"designs": int(len(g)), "converted": int((g["status"] == Status.OK).sum())}
             for f, g in table.groupby("folder")
         },
-        "median_seconds": float(table["seconds"].median()) if len(table) else None,
     }
-    metrics_file.parent.mkdir(parents=True, exist_ok=True)
-    metrics_file.write_text(json.dumps(metrics, indent=2))
+    write_json(details_file, details)
     print(
-        f"convert: {metrics['converted']}/{metrics['designs']} converted and verified "
-        f"({metrics['rate']:.2%}), by status {metrics['by_status']}"
+        f"convert: {int(ok.sum())}/{len(table)} converted and verified "
+        f"({ok.mean() if len(table) else 0.0:.2%}), by status {details['by_status']}"
     )
 
 
@@ -155,6 +153,7 @@ def main() -> None:
         (),
         out="the designs folder (index.parquet, json/)",
         metrics="the conversion metrics JSON",
+        details="the conversion's breakdowns JSON (by status, by folder)",
     )
     data, dask = section(DataParams, "data"), section(DaskParams, "dask")
     source, limit = data.source, data.limit
@@ -164,7 +163,7 @@ def main() -> None:
     elif source == "b123d":
         root = Path(_folder(data.b123d_dir, "b123d_dir")).expanduser().resolve()
         table = convert_corpus(root, limit, data.limit_seed, dask, data.convert_timeout_s, args.out)
-        write_conversion(table, args.out, args.metrics)
+        write_conversion(table, args.out, args.metrics, args.details)
         folder = args.out / "json"
     elif source == "synthetic":
         syn = section(SyntheticParams, "synthetic")
@@ -180,9 +179,9 @@ def main() -> None:
     if source == "fusion_json" and limit is not None:
         records = [records[i] for i in stratified_sample(["all"] * len(records), limit, seed)]
     write_index(records, table if source == "b123d" else None, args.out)
-    if source != "b123d":  # nothing converted: the metric says so
-        args.metrics.parent.mkdir(parents=True, exist_ok=True)
-        args.metrics.write_text(json.dumps({"source": source, "designs": len(records)}, indent=2))
+    if source != "b123d":  # nothing converted: every design is one as read
+        write_json(args.metrics, headline(len(records), len(records), ()))
+        write_json(args.details, {"source": source})
     print(f"generate: {len(records)} designs from {folder} ({source})")
 
 

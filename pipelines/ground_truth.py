@@ -7,17 +7,18 @@ captured gets a heuristic search (``ground_truth.budget_s``) to tell "another se
 from "not reconstructed". Outputs: ``data/gt/steps.parquet`` (design, graph, step, operation, GT
 zone ids, captured and proposal count at each level, mapping check, reason),
 ``data/gt/designs.parquet`` (one row per design of the run, failures of earlier stages included),
-``data/gt/coverage.md``, ``data/plots/coverage.png`` and ``data/metrics/coverage.json``.
+``data/gt/coverage.md``, ``data/plots/coverage.png``, ``data/metrics/coverage.json`` and every
+variant's categories in ``data/details/coverage.json``.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pandas as pd
 
 from eval.coverage import CATEGORIES, coverage_table, plot_coverage, to_markdown
+from eval.dvc_metrics import headline, write_json
 from zonegraph.jobs import ground_truth_and_coverage
 from zonegraph.status import Status
 
@@ -56,6 +57,7 @@ def main() -> None:
         out="the ground truth folder",
         plot="the coverage plot (PNG)",
         metrics="the coverage metrics JSON",
+        details="the coverage categories of every graph and level, JSON",
     )
     cfg = section(GroundTruthParams, "ground_truth")
     levels = cfg.levels
@@ -100,12 +102,20 @@ def main() -> None:
     results = results.drop(columns=["status", "reason"]).rename(columns={"seconds": "gt_seconds"})
     designs = table.merge(results, on="design_id", how="left")
     designs.to_parquet(args.out / "designs.parquet", index=False)
-    write_coverage(designs, levels, args.out, args.plot, args.metrics)
+    write_coverage(designs, levels, args.out, args.plot, args.metrics, args.details)
 
 
 def write_coverage(
-    designs: pd.DataFrame, levels: tuple[int, ...], out: Path, plot: Path, metrics_file: Path
+    designs: pd.DataFrame,
+    levels: tuple[int, ...],
+    out: Path,
+    plot: Path,
+    metrics_file: Path,
+    details_file: Path,
 ) -> None:
+    """The coverage tables and plot; the metrics' ``ok`` counts the designs whose simplified
+    graph's ground truth was computed; the share of all designs whose GT the first variant
+    captures and every variant's categories go to the details."""
     variants = {
         f"{graph} graph, level {level}": (graph, level)
         for graph in ("simplified", "full")
@@ -115,15 +125,16 @@ def write_coverage(
     (out / "coverage.md").write_text(to_markdown(tables))
     first = next(iter(tables))
     plot_coverage(tables[first], plot, f"Coverage ({first}), {len(designs)} designs")
+    n = len(designs)
+    ok = int((designs["simplified_status"] == Status.OK).sum()) if "simplified_status" in designs else 0
+    write_json(metrics_file, headline(n, ok, designs["gt_seconds"]))
     seconds = designs["gt_seconds"].dropna()
-    metrics = {
-        "designs": int(len(designs)),
-        "seconds_per_design_median": float(seconds.median()) if len(seconds) else None,
+    details = {
+        "captured": int(tables[first].loc["gt_captured", "all"]) / n if n else None,
         "seconds_per_design_mean": float(seconds.mean()) if len(seconds) else None,
         **{name: {c: int(t.loc[c, "all"]) for c in CATEGORIES} for name, t in tables.items()},
     }
-    metrics_file.parent.mkdir(parents=True, exist_ok=True)
-    metrics_file.write_text(json.dumps(metrics, indent=2))
+    write_json(details_file, details)
     t = tables[first]
     share = t["all"] / max(int(t["all"].sum()), 1)
     print(

@@ -8,15 +8,15 @@ what the relative GT rank of ``eval`` needs at a small part of the cost. Each de
 killable Dask task that writes its own shards, ``data/labels/proposals/<id>.parquet`` and
 ``data/labels/steps/<id>.parquet`` (schemas in docs/pipeline.md; read the folders with
 ``pyarrow.dataset``), so one bad design never loses the others and an interrupted run resumes.
-``data/metrics/labels.json`` counts designs, steps and labels (rank-only designs apart).
+``data/metrics/labels.json`` has the shared metrics keys (every design, training and rank-only);
+``data/details/labels.json`` counts designs, steps and labels (rank-only designs apart).
 """
 
 from __future__ import annotations
 
-import json
-
 import pandas as pd
 
+from eval.dvc_metrics import headline, write_json
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.jobs import label_and_save
 from zonegraph.status import Status
@@ -51,6 +51,7 @@ def main() -> None:
         ("gt", "zonegraphs"),
         out="the labels folder (shards, records)",
         metrics="the label metrics JSON",
+        details="the labels' counts JSON (designs, steps and labels; rank-only designs apart)",
     )
     out, graphs = args.out, args.zonegraphs / "graphs"
     cfg = section(LabelsParams, "labels")
@@ -121,8 +122,9 @@ def main() -> None:
     table = records_frame(records)
     ranked = table["design_id"].map(split_of).isin(rank_splits) if len(table) else pd.Series(dtype=bool)
     metrics = {**count(table[~ranked]), "rank_only": count(table[ranked]), "runner": retry_summary(records)}
-    args.metrics.parent.mkdir(parents=True, exist_ok=True)
-    args.metrics.write_text(json.dumps(metrics, indent=2))
+    ok = int((table["status"] == Status.OK).sum()) if len(table) else 0
+    write_json(args.metrics, headline(len(table), ok, table["seconds"] if len(table) else ()))
+    write_json(args.details, metrics)
     print(
         f"labels: {metrics['labelled']}/{metrics['designs']} designs, {metrics['labelled_steps']} steps, "
         f"{metrics['proposals']} proposals (+{metrics['positives']} / 0 {metrics['neutrals']} / "

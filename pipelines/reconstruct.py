@@ -5,17 +5,19 @@ the same budget (``params.yaml: reconstruct``), starting from the zone graph the
 stage saved (zone-graph build time is excluded from the budget, as in the paper). Results:
 ``data/reconstruct/results.parquet`` (one row per design and guide), each program under
 ``data/reconstruct/<guide>/<id>/`` and the metrics
-(exact rate, mean B-rep IoU, median time to exact, per guide) in ``data/metrics/reconstruct.json``.
+(exact rate, mean B-rep IoU per guide) in ``data/metrics/reconstruct/<guide>.json``, with the median
+time to exact and the failures in ``data/details/reconstruct.json``.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from eval.dvc_metrics import headline, median, write_guides, write_json
 from zonegraph.configs import InferConfig
 from zonegraph.reconstruction import infer
 from zonegraph.status import Status
@@ -36,7 +38,9 @@ def reconstruct_design(target: str, out: str, config: InferConfig, saved_graph: 
     return result
 
 
-def summarise(results: pd.DataFrame) -> dict:
+def summarise(results: pd.DataFrame) -> dict[str, dict]:
+    """Per guide: the designs, those searched, the exact rate and mean B-rep IoU of all of them,
+    the median time to exact and the failures by status."""
     metrics = {}
     for guide, rows in results.groupby("guide"):
         ok = rows[rows["status"].isin([s.value for s in SEARCHED])]
@@ -47,6 +51,7 @@ def summarise(results: pd.DataFrame) -> dict:
             "exact_rate": float(len(exact) / len(rows)) if len(rows) else 0.0,
             "mean_iou_brep": float(ok["iou_brep"].fillna(0).sum() / len(rows)) if len(rows) else 0.0,
             "median_time_to_exact_s": float(np.median(exact["time_to_best_s"])) if len(exact) else None,
+            "median_seconds": median(rows["seconds"]),
             "failures": {
                 k: int(v) for k, v in rows.loc[~rows.index.isin(ok.index), "status"].value_counts().items()
             },
@@ -54,12 +59,31 @@ def summarise(results: pd.DataFrame) -> dict:
     return metrics
 
 
+def write_metrics(summary: dict[str, dict], metrics_dir: Path, details_file: Path) -> None:
+    """One metrics file per guide (a row of ``dvc metrics show``), the summary as the details."""
+    write_guides(
+        metrics_dir,
+        {
+            guide: headline(
+                m["designs"],
+                m["searched"],
+                (m["median_seconds"],),
+                exact=m["exact_rate"],
+                iou=m["mean_iou_brep"],
+            )
+            for guide, m in summary.items()
+        },
+    )
+    write_json(details_file, summary)
+
+
 def main() -> None:
     args = stage_paths(
         __doc__,
         ("replay", "zonegraphs"),
         out="the reconstructions folder",
-        metrics="the reconstruction metrics JSON",
+        metrics="the reconstruction metrics folder (one JSON per guide)",
+        details="the reconstruction's per-guide summary JSON (time to exact, failures by status)",
     )
     cfg = section(ReconstructParams, "reconstruct")
     replayed = pd.read_parquet(args.replay / "manifest.parquet")
@@ -108,8 +132,7 @@ def main() -> None:
     results = pd.concat([results, *skipped], ignore_index=True)
     results.to_parquet(args.out / "results.parquet", index=False)
     metrics = summarise(results)
-    args.metrics.parent.mkdir(parents=True, exist_ok=True)
-    args.metrics.write_text(json.dumps(metrics, indent=2))
+    write_metrics(metrics, args.metrics, args.details)
     for guide, m in metrics.items():
         print(
             f"reconstruct [{guide}]: exact {m['exact_rate']:.1%} of {m['designs']}, mean B-rep IoU "

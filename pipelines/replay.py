@@ -6,12 +6,11 @@ B-reps are BREP files in the design's centimetres: ``breps/<id>/final.brep`` of 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
+from eval.dvc_metrics import headline, write_json
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.geometry.shapes import write_brep
@@ -57,6 +56,7 @@ def main() -> None:
         ("designs",),
         out="the replay folder (manifest, breps)",
         metrics="the replay metrics JSON",
+        details="the replay's breakdowns JSON (failures by status, volume error, retries)",
     )
     cfg = section(ReplayParams, "replay")
     index = pd.read_parquet(args.designs / "index.parquet")
@@ -88,20 +88,24 @@ def main() -> None:
     manifest["brep_dir"] = [str(args.out / "breps" / d) for d in manifest["design_id"]]  # where they are now
     manifest.insert(1, "split", index["split"].to_numpy())
     manifest.to_parquet(args.out / "manifest.parquet", index=False)
-    ok = manifest["status"] == Status.OK
-    metrics = {
-        "designs": int(len(manifest)),
-        "ok": int(ok.sum()),
-        "failed": {k: int(v) for k, v in manifest.loc[~ok, "status"].value_counts().items()},
-        "median_seconds": float(np.median(manifest["seconds"])) if len(manifest) else 0.0,
-        "max_volume_rel_error": float(manifest.loc[ok, "volume_rel_error"].max()) if ok.any() else None,
-        "runner": retry_summary(records),
-    }
-    args.metrics.parent.mkdir(parents=True, exist_ok=True)
-    args.metrics.write_text(json.dumps(metrics, indent=2))
-    print(f"replay: {metrics['ok']}/{metrics['designs']} designs ok, failures {metrics['failed']}")
+    ok = write_metrics(manifest, retry_summary(records), args.metrics, args.details)
     for row in manifest.loc[~ok].itertuples():
         print(f"  {row.design_id}: {row.status}: {row.reason}")
+
+
+def write_metrics(manifest: pd.DataFrame, retries: dict, metrics_file: Path, details_file: Path) -> pd.Series:
+    """The shared metrics keys and the breakdowns; returns which designs replayed."""
+    ok = manifest["status"] == Status.OK
+    write_json(metrics_file, headline(len(manifest), int(ok.sum()), manifest["seconds"]))
+    failed = {k: int(v) for k, v in manifest.loc[~ok, "status"].value_counts().items()}
+    details = {
+        "failed_by_status": failed,
+        "max_volume_rel_error": float(manifest.loc[ok, "volume_rel_error"].max()) if ok.any() else None,
+        "runner": retries,
+    }
+    write_json(details_file, details)
+    print(f"replay: {int(ok.sum())}/{len(manifest)} designs ok, failures {failed}")
+    return ok
 
 
 if __name__ == "__main__":

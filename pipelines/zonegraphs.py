@@ -7,13 +7,13 @@ edges, build seconds, simplified), designs that failed to replay included with t
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from eval.dvc_metrics import headline, write_json
 from zonegraph.configs import BuildConfig
 from zonegraph.jobs import build_and_save
 from zonegraph.status import Status
@@ -31,6 +31,7 @@ def main() -> None:
         ("replay",),
         out="the zone graphs folder (manifest, graphs)",
         metrics="the zone graph metrics JSON",
+        details="the zone graphs' breakdowns JSON (by status, build seconds, zones, retries)",
     )
     cfg = section(ZoneGraphParams, "zonegraph")
     replayed = pd.read_parquet(args.replay / "manifest.parquet")
@@ -70,26 +71,29 @@ def main() -> None:
     )
     manifest["simplified"] = config.simplify
     manifest.to_parquet(args.out / "manifest.parquet", index=False)
-    write_metrics(manifest, args.metrics, retry_summary(records))
+    write_metrics(manifest, args.metrics, args.details, retry_summary(records))
 
 
-def write_metrics(manifest: pd.DataFrame, metrics_file: Path, retries: dict | None = None) -> None:
+def write_metrics(
+    manifest: pd.DataFrame, metrics_file: Path, details_file: Path, retries: dict | None = None
+) -> None:
+    """The shared metrics keys (as every stage: seconds is the median job, build and saving) and
+    the breakdowns."""
     ok = manifest["status"] == Status.OK
     build = manifest.loc[ok, "build_s"].to_numpy(float) if "build_s" in manifest else np.zeros(0)
-    metrics = {
-        "designs": int(len(manifest)),
-        "ok": int(ok.sum()),
+    seconds = manifest["job_seconds"] if "job_seconds" in manifest else ()
+    write_json(metrics_file, headline(len(manifest), int(ok.sum()), seconds))
+    details = {
         "by_status": {k: int(v) for k, v in manifest["status"].value_counts().items()},
         "median_build_s": float(np.median(build)) if len(build) else None,
         "p90_build_s": float(np.percentile(build, 90)) if len(build) else None,
         "median_zones": float(manifest.loc[ok, "zones"].median()) if ok.any() else None,
         "runner": retries or {},
     }
-    metrics_file.parent.mkdir(parents=True, exist_ok=True)
-    metrics_file.write_text(json.dumps(metrics, indent=2))
+    write_json(details_file, details)
     print(
-        f"zonegraphs: {metrics['ok']}/{metrics['designs']} ok, median build {metrics['median_build_s']} s, "
-        f"by status {metrics['by_status']}"
+        f"zonegraphs: {int(ok.sum())}/{len(manifest)} ok, median build {details['median_build_s']} s, "
+        f"by status {details['by_status']}"
     )
     for row in manifest.loc[~ok].itertuples():
         print(f"  {row.design_id}: {row.status}: {row.reason}")

@@ -4,7 +4,8 @@ A page writes ``<!-- figure: KIND NAME ... -->`` where a table belongs; the hook
 the table drawn from ``docs/figures/NAME.json`` (written by ``python -m bench.figures``), each
 table followed by the command and commit that measured it. An unknown kind or a missing figure
 file stops the build, so ``mkdocs build --strict`` in ``make test`` fails rather than publishing a
-stale or invented number.
+stale or invented number. ``<!-- typed: COMMIT -->`` marks a number typed from a command's output
+before its results file was kept, with the commit that added it.
 """
 
 from __future__ import annotations
@@ -16,6 +17,9 @@ from pathlib import Path
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 MARKER = re.compile(r"<!--\s*figure:\s*([\w-]+)((?:\s+[\w.-]+)+)\s*-->")
+# A number typed from a command's output whose results file is not kept any more: the page names
+# the command beside it, the marker the commit that added it (never a new figure made up for it).
+TYPED = re.compile(r"<!--\s*typed:\s*([0-9a-f]{7,40})\s*-->")
 
 
 def _load(name: str) -> dict:
@@ -91,7 +95,83 @@ def fusion_diff(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
-RENDERERS: dict[str, Callable[[list[dict]], str]] = {"corpus-exact": corpus_exact, "fusion-diff": fusion_diff}
+def conversion(records: list[dict]) -> str:
+    """The corpus conversion by timeline folder, with the failures by status."""
+    (r,) = records
+    f = r["figure"]
+    failed = ", ".join(f"`{k}` {v}" for k, v in sorted(f["failed_by_status"].items(), key=lambda kv: -kv[1]))
+    lines = [
+        f"**{_rate(f['converted'], f['designs'])} designs converted and verified.**",
+        "",
+        "| folder | designs | converted | rate |",
+        "|---|---|---|---|",
+        *(
+            f"| {k} | {g['designs']:,} | {g['converted']:,} | {g['converted'] / g['designs']:.2%} |"
+            for k, g in sorted(f["by_folder"].items())
+        ),
+        "",
+        f"Failures by status: {failed or 'none'}.",
+    ]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def fuzz(records: list[dict]) -> str:
+    """The fuzz benchmark's outcomes by command, one column per command."""
+    (r,) = records
+    f = r["figure"]
+    commands = sorted({c for counts in f["by_outcome"].values() for c in counts})
+    lines = [
+        "| outcome | inputs | " + " | ".join(commands) + " |",
+        "|---|---:|" + "---:|" * len(commands),
+        *(
+            f"| {o} | {sum(counts.values())} | " + " | ".join(str(counts.get(c, 0)) for c in commands) + " |"
+            for o, counts in f["by_outcome"].items()
+        ),
+        "",
+        f"{f['inputs']} inputs; user errors by status: "
+        + ", ".join(f"`{k}` {v}" for k, v in f["user_errors_by_status"].items())
+        + f"; the slowest input took {f['slowest_s']} s.",
+    ]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def _decade_key(k: str) -> int:
+    return -99 if k.startswith("<") else (99 if k == "-" else int(k[2:]))
+
+
+def verify(records: list[dict]) -> str:
+    """The verify benchmark's sample: our replay against Fusion by decade, the designs above the
+    threshold listed."""
+    (r,) = records
+    f = r["figure"]
+    keys = sorted(set(f["volume_decades"]) | set(f["area_decades"]), key=_decade_key)
+    lines = [
+        f"{f['designs']} designs, convert: {f['convert']}; `zonegraph replay` (defaults) on the "
+        f"{f['converted']} converted: exit codes {f['replay_exits']}.",
+        "",
+        "| relative difference, our replay vs Fusion | volume | area |",
+        "|---|---|---|",
+        *(f"| {k} | {f['volume_decades'].get(k, 0)} | {f['area_decades'].get(k, 0)} |" for k in keys),
+        "",
+        f"{len(f['above'])} of {f['converted']} converted designs differ from Fusion by more than "
+        f"{f['threshold']:g}:",
+        "",
+        *(
+            f"- `{a['design_id']}` ({a['batch']}): volume {a['volume']:.1e}, area {a['area']:.1e}, "
+            f"replay exit {a['replay_exit']}"
+            for a in f["above"]
+        ),
+    ]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+RENDERERS: dict[str, Callable[[list[dict]], str]] = {
+    "verify": verify,
+    "corpus-exact": corpus_exact,
+    "fusion-diff": fusion_diff,
+    "conversion": conversion,
+    "fuzz": fuzz,
+}
 
 
 def render(markdown: str) -> str:
@@ -101,7 +181,13 @@ def render(markdown: str) -> str:
             raise ValueError(f"unknown figure kind {kind!r} (known: {', '.join(RENDERERS)})")
         return RENDERERS[kind]([_load(n) for n in names])
 
-    return MARKER.sub(table, markdown)
+    def typed(match: re.Match) -> str:
+        return (
+            f"*Typed from the output of the command above when {match.group(1)} added it; "
+            "its results file is not kept, so a re-run does not update it.*"
+        )
+
+    return TYPED.sub(typed, MARKER.sub(table, markdown))
 
 
 def on_page_markdown(markdown: str, **_: object) -> str:

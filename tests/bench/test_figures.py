@@ -2,11 +2,12 @@
 
 import importlib.util
 import json
+import re
 from pathlib import Path
 
 import pytest
 
-from bench.figures import corpus_figure
+from bench.figures import conversion_figure, corpus_figure, fuzz_figure
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -66,3 +67,50 @@ def test_a_missing_figure_file_stops_the_build():
         _hook().render("<!-- figure: corpus-exact no-such-run -->")
     name = next((ROOT / "docs/figures").glob("*.json")).stem
     assert json.loads((ROOT / "docs/figures" / f"{name}.json").read_text())["command"]
+
+
+def test_conversion_and_fuzz_figures_count_from_the_stage_and_bench_outputs():
+    details = {
+        "by_status": {"ok": 3, "model_raised": 1},
+        "by_folder": {"01": {"designs": 2, "converted": 2}, "02": {"designs": 2, "converted": 1}},
+    }
+    f = conversion_figure(details)
+    assert (f["designs"], f["converted"], f["failed_by_status"]) == (4, 3, {"model_raised": 1})
+    rows = [
+        {"command": "build", "outcome": "success", "seconds": 0.5, "detail": ""},
+        {
+            "command": "infer",
+            "outcome": "user_error",
+            "seconds": 1.25,
+            "detail": "zonegraph: error: /x.json: invalid_design: bad",
+        },
+        {
+            "command": "infer",
+            "outcome": "user_error",
+            "seconds": 0.1,
+            "detail": "zonegraph: error: /y.step: invalid_input: empty",
+        },
+    ]
+    z = fuzz_figure(rows)
+    assert z["by_outcome"]["user_error"] == {"build": 0, "infer": 2} and z["slowest_s"] == 1.25
+    assert z["user_errors_by_status"] == {"invalid_design": 1, "invalid_input": 1}
+    hook = _hook()
+    record = {"name": "n", "command": "c", "commit": "abc1234", "measured": "today"}
+    assert "| user_error | 2 | 0 | 2 |" in hook.fuzz([{**record, "figure": z}])
+    assert "**3/4 (75.0%)" in hook.conversion([{**record, "figure": f}])
+
+
+def test_every_results_table_is_drawn_from_a_figure_or_marked_as_typed():
+    """A hand-typed table without its source is kept only with the commit that added it."""
+    hook = _hook()
+    assert "when 92348d7 added it" in hook.render("<!-- typed: 92348d7 -->")
+    for page in (ROOT / "docs/results").glob("*.md"):
+        blocks = page.read_text().split("\n\n")
+        for i, block in enumerate(blocks):
+            cells = [c.strip() for c in block.split("|---", 1)[-1].split("|")]
+            numbers = [c for c in cells if re.fullmatch(r"[*]*[\d.,]+%?[*]*(\s.*)?", c)]
+            if block.lstrip().startswith("|") and "|---" in block and numbers:
+                after = blocks[i + 1] if i + 1 < len(blocks) else ""
+                assert after.startswith("<!-- typed:"), (
+                    f"{page.name}: a typed table without its commit: {block[:80]}"
+                )

@@ -58,3 +58,6 @@ def test_metric_names_are_grouped_and_runs_named():
         run_name({"designs": "test", "budget": 2.0, "k": [1, 5], "seed": 0})
         == "evaluate test 2.0s k1-5 seed0"
     )
+    assert (
+        run_name({"designs": "parts", "budget_s": 2.0, "k": [5]}) == "evaluate parts 2.0s k5 seed0"
+    )  # eval.report's

@@ -145,9 +145,13 @@ def test_an_input_missing_on_the_worker_is_an_environment_failure(tmp_path):
 
 def test_a_stage_whose_designs_all_failed_writes_its_metrics(tmp_path):
     records = [{"design_id": "a", "fingerprint": "f", "status": "invalid_input", "reason": "no such file"}]
-    zonegraphs.write_metrics(records_frame(records, ("build_s", "zones")), tmp_path / "m.json")
+    zonegraphs.write_metrics(
+        records_frame(records, ("build_s", "zones")), tmp_path / "m.json", tmp_path / "d.json"
+    )
     metrics = json.loads((tmp_path / "m.json").read_text())
-    assert (metrics["ok"], metrics["median_build_s"], metrics["by_status"]) == (0, None, {"invalid_input": 1})
+    details = json.loads((tmp_path / "d.json").read_text())
+    assert metrics == {"designs": 1, "ok": 0, "failed": 1, "seconds": None}
+    assert (details["median_build_s"], details["by_status"]) == (None, {"invalid_input": 1})
 
 
 def test_a_memory_hog_is_out_of_memory():

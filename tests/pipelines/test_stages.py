@@ -68,7 +68,7 @@ def test_stages_on_the_real_samples_folder(samples_dir, tmp_path):
     assert len(ranked) and (ranked["completions"] == 0).all() and ranked["label"].isin([0, 1]).all()
     trained = proposals[proposals["split"] == "train"]
     assert (trained["completions"] >= 1).any() and (trained["label"] == -1).any()
-    metrics = json.loads((tmp_path / "data/metrics/labels.json").read_text())
+    metrics = json.loads((tmp_path / "data/details/labels.json").read_text())
     assert metrics["rank_only"]["labelled"] == ranked["design_id"].nunique()
     assert metrics["labelled"] == trained["design_id"].nunique() and metrics["rank_only"]["completions"] == 0
     # An interrupted run resumes: the finished designs are kept, the lost one recomputed, equal.
