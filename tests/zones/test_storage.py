@@ -140,7 +140,7 @@ def test_a_step_target_is_read_by_the_kernel_alone_as_build123d_reads_it(samples
     assert [volume_props(s)[0] for s in ours] == pytest.approx([s.volume for s in theirs], rel=1e-12)
     code = (
         "import sys; from zonegraph.cli import _build_job; from zonegraph.configs import BuildConfig\n"
-        "_build_job(BuildConfig(), 60)\n"  # what the command imports before its child
+        "_build_job(BuildConfig(), 60, None)\n"  # what the command imports before its child
         "from zonegraph.build_job import build_and_save\n"
         f"build_and_save({str(step)!r}, {str(tmp_path / 'g')!r}, mesh=True)\n"
         "heavy = ('build123d', 'trimesh', 'scipy', 'zonegraph.sequence', 'zonegraph.jobs')\n"
