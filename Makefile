@@ -22,8 +22,10 @@ install: $(STAMP)
 run: $(STAMP)
 	PATH="$(abspath $(BIN)):$$PATH" $(BIN)/dvc repro
 
+# Two test processes (pytest-xdist), a file's tests kept together so that its fixtures are built
+# once: the suite is CPU-bound and CI has 2 cores. The slowest tests are listed at the end.
 test: $(STAMP) lint docs-build
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile --durations=15
 
 # The documentation site (docs/, mkdocs.yml): `make docs` serves it on http://127.0.0.1:8000;
 # `make test` builds it with --strict, so a broken link or a missing API reference fails CI.
