@@ -296,7 +296,9 @@ class ProposalGenerator:
         """The sweep of every face on s whose zone beyond it (towards e) lies outside the target,
         on the pair (s, e) (memoised), or None when ``deadline`` passes. Only those faces are
         swept: every face on every pair is most of a many-zone graph's setup, and a face next to
-        a target zone needs none (groups 1-3 place it by that zone)."""
+        a target zone needs none (groups 1-3 place it by that zone). The sweeps are kept as zone
+        indices, not memoised as sweeps: a (Z,) array for every face of every pair of a
+        many-zone graph is more memory than the graph."""
         hit = self._reach.get((s, e))
         if hit is None:
             beyond = self._beyond[(s, e)]
@@ -305,12 +307,12 @@ class ProposalGenerator:
             for face, swept_needed in zip(self.faces_on[s].tolist(), outside.tolist(), strict=True):
                 if deadline is not None and deadline.passed():
                     return None
-                swept = self.sweep(face, s, e) if swept_needed else None
+                swept = self._sweep(face, s, e) if swept_needed else None
                 starts.append(len(zones))
                 ok.append(swept is not None)
                 zones.extend(np.flatnonzero(swept.zones).tolist() if swept is not None else [0])
             hit = self._reach[(s, e)] = _Reach(
-                np.array(ok, bool), np.array(zones, np.int64), np.array(starts, np.int64)
+                np.array(ok, bool), np.array(zones, np.int32), np.array(starts, np.int64)
             )
         return hit
 
