@@ -303,7 +303,9 @@ class ProposalGenerator:
         if hit is None:
             beyond = self._beyond[(s, e)]
             outside = (beyond >= 0) & ~self.target[np.maximum(beyond, 0)]
-            ok, zones, starts = [], [], []
+            ok: list[bool] = []
+            zones: list[int] = []
+            starts: list[int] = []
             for face, swept_needed in zip(self.faces_on[s].tolist(), outside.tolist(), strict=True):
                 if deadline is not None and deadline.passed():
                     return None
