@@ -448,27 +448,42 @@ class ProposalGenerator:
         )
         counts = [np.concatenate(([0], np.cumsum(g))) for g in groups]
         filled = [c[self._ends] > c[self._starts] for c in counts]  # a group has faces on the pair
+        found: list[_Candidates] = []
+        masks = [
+            (i, [mask[self._starts[i] : self._ends[i]] for g, mask in enumerate(groups) if filled[g][i]])
+            for i in range(len(self.pairs))
+        ]
+        if not self._extend(found, masks, deadline):
+            return self._distinct(found, canvas) if found else []
+        # Groups 4 and 5 after every pair's groups 1-3: their sweeps are the costly part of a first
+        # expansion, and a deadline that passes during them leaves the proposals of groups 1-3.
         nothing = np.zeros_like(canvas)
         needs = ((canvas & ~self.target, canvas & self.target), (self.target & ~canvas, nothing))
-        found: list[_Candidates] = []
         for i, (s, e) in enumerate(self.pairs):
-            a, b = self._starts[i], self._ends[i]
-            masks = [mask[a:b] for g, mask in enumerate(groups) if filled[g][i]]
             reach = self._reach_of(s, e, deadline)
             if reach is None:
-                return self._distinct(found, canvas) if found else []
+                break
             cut, join = reach.meets(*needs[0]), reach.meets(*needs[1])
-            masks += [cut] if cut.any() else []
-            masks += [join | groups[1][a:b]] if join.any() else []
-            for mask_s in masks:
-                cand = self._candidates(s, e, mask_s, deadline)
+            extra = [cut] if cut.any() else []
+            extra += [join | groups[1][self._starts[i] : self._ends[i]]] if join.any() else []
+            if not self._extend(found, [(i, extra)], deadline):
+                break
+        return self._distinct(found, canvas) if found else []
+
+    def _extend(
+        self, found: list[_Candidates], masks: list[tuple[int, list[np.ndarray]]], deadline: Deadline | None
+    ) -> bool:
+        """Append to ``found`` the candidates of each (pair index, face masks on its start plane)
+        that have any; False when ``deadline`` passed first."""
+        for i, pair_masks in masks:
+            s, e = self.pairs[i]
+            for mask in pair_masks:
+                cand = self._candidates(s, e, mask, deadline)
                 if cand is None:
-                    return self._distinct(found, canvas) if found else []
+                    return False
                 if cand.union:
                     found.append(cand)
-        if not found:
-            return []
-        return self._distinct(found, canvas)
+        return True
 
     @staticmethod
     def _distinct(found: list[_Candidates], canvas: np.ndarray) -> list[Proposal]:
