@@ -5,7 +5,14 @@ partition faces on s are grouped by the zone just beyond them along d:
 
 1. in the canvas but not the target: can start a subtraction;
 2. in the target but not the canvas: can start a union;
-3. in the target, or in neither: can start a union.
+3. in the target, or in neither: can start a union;
+4. whose sweep to e (below) meets a zone in the canvas but not the target, and no zone in both:
+   can start a subtraction that removes only what must go;
+5. whose sweep to e meets a zone in the target but not the canvas: can start a union.
+
+Groups 4 and 5 are where a sketch's extent is set by what its prism reaches rather than by the
+zone next to the sketch plane: a through-cut or a boss drawn on the box face, whose first zones
+lie outside both canvas and target, so groups 1-3 lump its faces with the whole face.
 
 A sketch is a connected component of a group (faces sharing an edge on s), the union of the
 group's components, or (proposal level k) any 1..k or N-k..N of them. Each sketch face is swept
@@ -101,6 +108,29 @@ class Proposal:
 
 
 @dataclass(frozen=True)
+class _Reach:
+    """The zones every face on one plane pair's start plane sweeps, flattened (canvas-independent).
+
+    Shapes:
+        ok: (F_s,) bool, the face's sweep fills its prism; zones: (N,) int, the swept zones of
+        all faces in order (one placeholder zone for a face whose sweep fails); starts: (F_s,)
+        int, where each face's zones begin in ``zones``.
+    """
+
+    ok: np.ndarray
+    zones: np.ndarray
+    starts: np.ndarray
+
+    def meets(self, need: np.ndarray, avoid: np.ndarray) -> np.ndarray:
+        """(F_s,) bool: the faces whose sweep fills its prism, holds a zone of ``need`` (Z,) bool
+        and none of ``avoid`` (Z,) bool."""
+        if not len(self.ok):
+            return self.ok
+        hits = np.logical_or.reduceat(need[self.zones], self.starts)
+        return self.ok & hits & ~np.logical_or.reduceat(avoid[self.zones], self.starts)
+
+
+@dataclass(frozen=True)
 class _Candidates:
     """The extrusions of one face group on one plane pair, as a union and a subtraction each.
 
@@ -142,6 +172,7 @@ class ProposalGenerator:
         self._side_lists: dict[int, list[int]] = {}
         self._crossed: dict[tuple[int, int], tuple[list[bool], list[bool]]] = {}
         self._groups: dict[tuple[int, int, bytes], _Candidates] = {}
+        self._reach: dict[tuple[int, int], _Reach] = {}
         self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
         self._flatten_pairs()
 
@@ -260,6 +291,32 @@ class ProposalGenerator:
         if face not in under or abs(volume - area * length) > PRISM_RTOL * area * length:
             return None
         return Sweep(zones, tuple(under))
+
+    def _reach_of(self, s: int, e: int, deadline: Deadline | None) -> _Reach | None:
+        """The sweep of every face on s whose zone beyond it (towards e) lies outside the target,
+        on the pair (s, e) (memoised), or None when ``deadline`` passes. Only those faces are
+        swept: every face on every pair is most of a many-zone graph's setup, and a face next to
+        a target zone needs none (groups 1-3 place it by that zone). The sweeps are kept as zone
+        indices, not memoised as sweeps: a (Z,) array for every face of every pair of a
+        many-zone graph is more memory than the graph."""
+        hit = self._reach.get((s, e))
+        if hit is None:
+            beyond = self._beyond[(s, e)]
+            outside = (beyond >= 0) & ~self.target[np.maximum(beyond, 0)]
+            ok: list[bool] = []
+            zones: list[int] = []
+            starts: list[int] = []
+            for face, swept_needed in zip(self.faces_on[s].tolist(), outside.tolist(), strict=True):
+                if deadline is not None and deadline.passed():
+                    return None
+                swept = self._sweep(face, s, e) if swept_needed else None
+                starts.append(len(zones))
+                ok.append(swept is not None)
+                zones.extend(np.flatnonzero(swept.zones).tolist() if swept is not None else [0])
+            hit = self._reach[(s, e)] = _Reach(
+                np.array(ok, bool), np.array(zones, np.int32), np.array(starts, np.int64)
+            )
+        return hit
 
     def _faces_under(self, zones: np.ndarray, s: int, e: int) -> list[int]:
         """The faces on s whose zone along d (from s to e) is one of ``zones``, sorted."""
@@ -392,18 +449,41 @@ class ProposalGenerator:
         counts = [np.concatenate(([0], np.cumsum(g))) for g in groups]
         filled = [c[self._ends] > c[self._starts] for c in counts]  # a group has faces on the pair
         found: list[_Candidates] = []
+        masks = [
+            (i, [mask[self._starts[i] : self._ends[i]] for g, mask in enumerate(groups) if filled[g][i]])
+            for i in range(len(self.pairs))
+        ]
+        if not self._extend(found, masks, deadline):
+            return self._distinct(found, canvas) if found else []
+        # Groups 4 and 5 after every pair's groups 1-3: their sweeps are the costly part of a first
+        # expansion, and a deadline that passes during them leaves the proposals of groups 1-3.
+        nothing = np.zeros_like(canvas)
+        needs = ((canvas & ~self.target, canvas & self.target), (self.target & ~canvas, nothing))
         for i, (s, e) in enumerate(self.pairs):
-            a, b = self._starts[i], self._ends[i]
-            for g, mask in enumerate(groups):
-                if filled[g][i]:
-                    cand = self._candidates(s, e, mask[a:b], deadline)
-                    if cand is None:
-                        return self._distinct(found, canvas) if found else []
-                    if cand.union:
-                        found.append(cand)
-        if not found:
-            return []
-        return self._distinct(found, canvas)
+            reach = self._reach_of(s, e, deadline)
+            if reach is None:
+                break
+            cut, join = reach.meets(*needs[0]), reach.meets(*needs[1])
+            extra = [cut] if cut.any() else []
+            extra += [join | groups[1][self._starts[i] : self._ends[i]]] if join.any() else []
+            if not self._extend(found, [(i, extra)], deadline):
+                break
+        return self._distinct(found, canvas) if found else []
+
+    def _extend(
+        self, found: list[_Candidates], masks: list[tuple[int, list[np.ndarray]]], deadline: Deadline | None
+    ) -> bool:
+        """Append to ``found`` the candidates of each (pair index, face masks on its start plane)
+        that have any; False when ``deadline`` passed first."""
+        for i, pair_masks in masks:
+            s, e = self.pairs[i]
+            for mask in pair_masks:
+                cand = self._candidates(s, e, mask, deadline)
+                if cand is None:
+                    return False
+                if cand.union:
+                    found.append(cand)
+        return True
 
     @staticmethod
     def _distinct(found: list[_Candidates], canvas: np.ndarray) -> list[Proposal]:
