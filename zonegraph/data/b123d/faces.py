@@ -1,0 +1,89 @@
+"""A profile face from the edges of a Fusion profile whose loop runs along a slit.
+
+Fusion lists a profile whose hole touches its outer boundary through a construction line (a slit
+of zero width, walked out and back by the loop) with that line once among its curves. The scripts
+pass those curves to ``make_face()``; build123d 0.10 built *some* face from the open wire, 0.13
+refuses it ("Face can only be created with closed wires"). The region Fusion meant is the one
+bounded by the closed loops left once every bridge (an edge on no cycle: the slit, a line ending
+inside another curve) is dropped: the outermost loop, less the loops inside it.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from typing import Any
+
+import numpy as np
+
+VERTEX_TOL = 1e-6  # cm: two end points closer than this are one sketch point
+
+
+class NotAProfile(ValueError):
+    """The edges do not bound one region once their bridges are dropped."""
+
+
+def slit_profile_face(edges: list[Any]) -> Any:
+    """The face the closed loops of ``edges`` bound (bridges dropped), or :class:`NotAProfile`."""
+    from build123d import Face, Wire
+
+    kept = _without_bridges(edges)
+    if not kept or len(kept) == len(edges):
+        raise NotAProfile("no bridge to drop")
+    wires = Wire.combine(kept)
+    if not all(w.is_closed for w in wires):
+        raise NotAProfile("the loops left do not close")
+    filled = sorted(((Face(w).area, w) for w in wires), key=lambda aw: -aw[0])
+    (outer_area, outer), holes = filled[0], filled[1:]
+    outer_face = Face(outer)
+    for _, hole in holes:  # each must lie inside the outer loop, or the edges bound several regions
+        common = outer_face.intersect(Face(hole)) or []
+        inside = sum(f.area for f in common.faces()) if hasattr(common, "faces") else 0.0
+        if abs(inside - Face(hole).area) > 1e-9 * max(outer_area, 1.0):
+            raise NotAProfile("the loops left bound more than one region")
+    return Face(outer, [h for _, h in holes])
+
+
+def _without_bridges(edges: list[Any]) -> list[Any]:
+    """``edges`` less every edge that lies on no cycle of their end-point graph."""
+    ends = [(_point(e @ 0), _point(e @ 1)) for e in edges]
+    ids = _vertex_ids([p for pair in ends for p in pair])
+    links = [(ids[2 * i], ids[2 * i + 1]) for i in range(len(edges))]
+    return [e for i, e in enumerate(edges) if not _is_bridge(i, links)]
+
+
+def _point(v: Any) -> np.ndarray:
+    return np.array([float(v.X), float(v.Y), float(v.Z)])
+
+
+def _vertex_ids(points: list[np.ndarray]) -> list[int]:
+    """Each point's vertex number; points within :data:`VERTEX_TOL` share one."""
+    reps: list[np.ndarray] = []
+    out = []
+    for p in points:
+        for k, r in enumerate(reps):
+            if np.linalg.norm(p - r) <= VERTEX_TOL:
+                out.append(k)
+                break
+        else:
+            reps.append(p)
+            out.append(len(reps) - 1)
+    return out
+
+
+def _is_bridge(i: int, links: list[tuple[int, int]]) -> bool:
+    """Whether edge ``i``'s end points are disconnected once it is removed (a loop never is)."""
+    a, b = links[i]
+    if a == b:
+        return False
+    graph: dict[int, set[int]] = defaultdict(set)
+    for j, (u, v) in enumerate(links):
+        if j != i:
+            graph[u].add(v)
+            graph[v].add(u)
+    seen, stack = {a}, [a]
+    while stack:
+        for n in graph[stack.pop()]:
+            if n not in seen:
+                seen.add(n)
+                stack.append(n)
+    return b not in seen
