@@ -19,6 +19,7 @@ from zonegraph.errors import UnsupportedFeatureError
 from zonegraph.geometry.occ import precise_area
 
 PLANE_TOL = 1e-6  # cm: a profile point may sit this far off its sketch plane
+VERTEX_TOL = 1e-7  # cm: a wire's walk is back at a vertex it passed (OCC shares the vertex)
 
 
 @dataclass(frozen=True)
@@ -71,8 +72,8 @@ def face_record(face: Any, plane: Any) -> RecordedFace:
     wires = [(True, face.outer_wire())] + [(False, w) for w in face.inner_wires()]
     loops: list[Loop] = []
     dropped = 0
-    for outer, wire in wires:
-        curves = [edge_curve(e, local) for e in wire.edges()]
+    for outer, edges in (loop for role, wire in wires for loop in wire_loops(face, wire, role)):
+        curves = [edge_curve(e, local) for e in edges]
         # The replay snaps end points closer than SNAP_TOL together, so such a line would collapse to
         # a point (and fail); its neighbours are joined across the gap instead, as the replay does.
         kept = [c for c in curves if not (isinstance(c, Line) and _length(c) < SNAP_TOL)]
@@ -88,6 +89,67 @@ def face_record(face: Any, plane: Any) -> RecordedFace:
         float(face.area),
         dropped,
     )
+
+
+def wire_loops(face: Any, wire: Any, outer: bool) -> list[tuple[bool, list[Any]]]:
+    """A wire's edges as simple loops, each with its role (outer or hole).
+
+    OpenCASCADE accepts a wire that passes a vertex twice: a hole touching the outer boundary at
+    one point (a circle tangent to it) is walked as part of the outer wire. The replay joins each
+    loop into one closed wire, so such a wire is cut at its repeated vertices; the largest piece
+    keeps the wire's role, and a piece inside it bounds the opposite side (a hole of an outer wire).
+    A wire with no repeated vertex is returned as it is, edges in their own order.
+    """
+    from build123d import Edge, Face, Wire
+
+    pieces = _simple_cycles(face, wire)
+    if len(pieces) == 1:
+        return [(outer, list(wire.edges()))]
+    edges = [[Edge(e) for e in p] for p in pieces]
+    filled = sorted(((Face(Wire(p)), p) for p in edges), key=lambda fp: -fp[0].area)
+    main = filled[0][0]
+    out = [(outer, filled[0][1])]
+    for piece_face, piece in filled[1:]:
+        common = main.intersect(piece_face) or []
+        inside = sum(f.area for f in common.faces()) if hasattr(common, "faces") else 0.0
+        within = abs(inside - piece_face.area) <= 1e-6 * piece_face.area
+        out.append((outer != within, piece))
+    return out
+
+
+def _simple_cycles(face: Any, wire: Any) -> list[list[Any]]:
+    """The wire's edges in walking order, cut into cycles wherever the walk returns to a vertex."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepTools import BRepTools_WireExplorer
+    from OCP.TopExp import TopExp
+
+    explorer = BRepTools_WireExplorer(wire.wrapped, face.wrapped)
+    walk = []
+    while explorer.More():
+        walk.append(explorer.Current())
+        explorer.Next()
+    if len(walk) < 2:
+        return [walk]
+
+    def end(edge: Any, last: bool) -> np.ndarray:
+        vertex = TopExp.LastVertex_s(edge, True) if last else TopExp.FirstVertex_s(edge, True)
+        return _v3(BRep_Tool.Pnt_s(vertex))
+
+    path = [end(walk[0], False)]
+    stack: list[Any] = []
+    cycles: list[list[Any]] = []
+    for edge in walk:
+        stack.append(edge)
+        v = end(edge, True)
+        hit = next((k for k, q in enumerate(path) if np.linalg.norm(v - q) <= VERTEX_TOL), None)
+        if hit is None:
+            path.append(v)
+            continue
+        cycles.append(stack[hit:])
+        del stack[hit:], path[hit + 1 :]
+    if stack:  # the walk did not close on its start: leave the wire whole
+        return [walk]
+    return cycles
 
 
 def face_area(face: Any) -> float | None:
