@@ -22,8 +22,12 @@ class NotAProfile(ValueError):
     """The edges do not bound one region once their bridges are dropped."""
 
 
-def slit_profile_face(edges: list[Any]) -> Any:
-    """The face the closed loops of ``edges`` bound (bridges dropped), or :class:`NotAProfile`."""
+def slit_profile_faces(edges: list[Any]) -> list[Any]:
+    """The faces the closed loops of ``edges`` bound (bridges dropped), or :class:`NotAProfile`.
+
+    Each loop inside no other is an outer boundary and the loops directly inside it its holes
+    (two holes joined by a slit are two holes); an island inside a hole is not a profile.
+    """
     from build123d import Face, Wire
 
     kept = _without_bridges(edges)
@@ -32,15 +36,27 @@ def slit_profile_face(edges: list[Any]) -> Any:
     wires = Wire.combine(kept)
     if not all(w.is_closed for w in wires):
         raise NotAProfile("the loops left do not close")
-    filled = sorted(((Face(w).area, w) for w in wires), key=lambda aw: -aw[0])
-    (outer_area, outer), holes = filled[0], filled[1:]
-    outer_face = Face(outer)
-    for _, hole in holes:  # each must lie inside the outer loop, or the edges bound several regions
-        common = outer_face.intersect(Face(hole)) or []
-        inside = sum(f.area for f in common.faces()) if hasattr(common, "faces") else 0.0
-        if abs(inside - Face(hole).area) > 1e-9 * max(outer_area, 1.0):
-            raise NotAProfile("the loops left bound more than one region")
-    return Face(outer, [h for _, h in holes])
+    filled = sorted(((Face(w), w) for w in wires), key=lambda fw: -fw[0].area)
+    outers: list[tuple[Any, Any, list[Any]]] = []  # (filled face, wire, holes)
+    for face, wire in filled:
+        container = next((o for o in reversed(outers) if _inside(face, o[0])), None)
+        if container is None:
+            if any(_inside(face, h) for o in outers for h in o[2]):
+                raise NotAProfile("a loop lies inside a hole")
+            outers.append((face, wire, []))
+        else:
+            container[2].append(wire)
+    return [Face(wire, holes) for _, wire, holes in outers]
+
+
+def _inside(face: Any, container: Any) -> bool:
+    """Whether ``face`` lies within ``container`` (their common area is all of ``face``)."""
+    from build123d import Face
+
+    container = container if isinstance(container, Face) else Face(container)
+    common = container.intersect(face) or []
+    inside = sum(f.area for f in common.faces()) if hasattr(common, "faces") else 0.0
+    return abs(inside - face.area) <= 1e-9 * max(container.area, 1.0)
 
 
 def _without_bridges(edges: list[Any]) -> list[Any]:

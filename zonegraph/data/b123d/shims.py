@@ -11,7 +11,7 @@ import inspect
 import types
 from typing import Any
 
-from zonegraph.data.b123d.faces import NotAProfile, slit_profile_face
+from zonegraph.data.b123d.faces import NotAProfile, slit_profile_faces
 
 
 def install_ocp_shims() -> None:
@@ -99,7 +99,7 @@ def _install_make_face_shim(module: types.ModuleType) -> None:
 
 
 def _slit_make_face(edges: Any, mode: Any, refusal: ValueError) -> Any:
-    """build123d's ``make_face`` steps with :func:`slit_profile_face` as the face (the refusal
+    """build123d's ``make_face`` steps with :func:`slit_profile_faces` as the face (the refusal
     re-raised where the edges are not a slit profile either)."""
     from build123d import BuildSketch, Compound, Curve, ShapeList, Sketch, Wire
     from build123d.build_common import flatten_sequence
@@ -111,12 +111,11 @@ def _slit_make_face(edges: Any, mode: Any, refusal: ValueError) -> Any:
     else:
         outer = list(context.pending_edges) if context is not None else []
     try:
-        face = slit_profile_face(outer)
+        faces = slit_profile_faces(outer)
     except NotAProfile:
         raise refusal from None
-    if face.normal_at().Z < 0:  # flip up-side-down faces, as make_face does
-        face = -face
+    faces = [-f if f.normal_at().Z < 0 else f for f in faces]  # flip up-side-down faces, as make_face does
     if context is not None:
-        context._add_to_context(face, mode=mode)
+        context._add_to_context(*faces, mode=mode)
         context.pending_edges = ShapeList()
-    return Sketch(Compound([face]).wrapped)
+    return Sketch(Compound(faces).wrapped)
