@@ -1,11 +1,14 @@
-"""A profile face from the edges of a Fusion profile whose loop runs along a slit.
+"""Profile faces from the curves of a Fusion profile that build123d 0.13 will not close.
 
-Fusion lists a profile whose hole touches its outer boundary through a construction line (a slit
-of zero width, walked out and back by the loop) with that line once among its curves. The scripts
-pass those curves to ``make_face()``; build123d 0.10 built *some* face from the open wire, 0.13
-refuses it ("Face can only be created with closed wires"). The region Fusion meant is the one
-bounded by the closed loops left once every bridge (an edge on no cycle: the slit, a line ending
-inside another curve) is dropped: the outermost loop, less the loops inside it.
+Two kinds of profile reach ``make_face()`` as curves that build123d 0.13 refuses ("Face can only be
+created with closed wires", where 0.10 built *some* face from the open wire):
+
+- a hole joined to its outer boundary (or to another hole) by a construction line: a slit of zero
+  width that Fusion's loop walks out and back, listed once among its curves;
+- end points apart by Fusion's float32 noise (~1e-6 cm at 20 cm), more than build123d's 1e-9.
+
+The region Fusion meant is bounded by the loops left once every bridge (an edge on no cycle: the
+slit, a line ending inside another curve) is dropped, joined at the replay's own snap tolerance.
 """
 
 from __future__ import annotations
@@ -15,7 +18,9 @@ from typing import Any
 
 import numpy as np
 
-VERTEX_TOL = 1e-6  # cm: two end points closer than this are one sketch point
+from zonegraph.data.profiles import SNAP_TOL
+
+VERTEX_TOL = SNAP_TOL  # cm: end points closer than the replay snaps together are one sketch point
 
 
 class NotAProfile(ValueError):
@@ -31,9 +36,9 @@ def slit_profile_faces(edges: list[Any]) -> list[Any]:
     from build123d import Face, Wire
 
     kept = _without_bridges(edges)
-    if not kept or len(kept) == len(edges):
-        raise NotAProfile("no bridge to drop")
-    wires = Wire.combine(kept)
+    if not kept:
+        raise NotAProfile("every curve is a bridge")
+    wires = Wire.combine(kept, tol=VERTEX_TOL)
     if not all(w.is_closed for w in wires):
         raise NotAProfile("the loops left do not close")
     filled = sorted(((Face(w), w) for w in wires), key=lambda fw: -fw[0].area)
