@@ -72,13 +72,14 @@ def face_record(face: Any, plane: Any) -> RecordedFace:
     wires = [(True, face.outer_wire())] + [(False, w) for w in face.inner_wires()]
     loops: list[Loop] = []
     dropped = 0
-    for outer, edges in (loop for role, wire in wires for loop in wire_loops(face, wire, role)):
-        curves = [edge_curve(e, local) for e in edges]
-        # The replay snaps end points closer than SNAP_TOL together, so such a line would collapse to
-        # a point (and fail); its neighbours are joined across the gap instead, as the replay does.
-        kept = [c for c in curves if not (isinstance(c, Line) and _length(c) < SNAP_TOL)]
-        dropped += len(curves) - len(kept)
-        loops.append(Loop(outer, tuple(kept)))
+    area = float(face.area) if len(wires) == 1 else None
+    for role, wire in wires:
+        whole = _loop(role, list(wire.edges()), local)
+        pieces = [whole] if _replay_keeps(whole[0], local.frame, area) else None
+        if pieces is None:  # a wire the replay cannot rebuild whole: its simple loops instead
+            pieces = [_loop(r, edges, local) for r, edges in wire_loops(face, wire, role)]
+        loops += [loop for loop, _ in pieces]
+        dropped += sum(n for _, n in pieces)
     normal = _v3(plane.z_dir)
     return RecordedFace(
         local.frame,
@@ -89,6 +90,34 @@ def face_record(face: Any, plane: Any) -> RecordedFace:
         float(face.area),
         dropped,
     )
+
+
+def _loop(outer: bool, edges: list[Any], local: _Local) -> tuple[Loop, int]:
+    """The edges as one loop of profile curves, and how many short lines it left out.
+
+    The replay snaps end points closer than SNAP_TOL together, so such a line would collapse to
+    a point (and fail); its neighbours are joined across the gap instead, as the replay does.
+    """
+    curves = [edge_curve(e, local) for e in edges]
+    kept = [c for c in curves if not (isinstance(c, Line) and _length(c) < SNAP_TOL)]
+    if not kept:  # the whole loop is smaller than the replay can draw
+        reason = f"a profile loop of {len(curves)} line(s), each shorter than {SNAP_TOL:g} cm"
+        raise UnsupportedFeatureError("", None, reason)
+    return Loop(outer, tuple(kept)), len(curves) - len(kept)
+
+
+def _replay_keeps(loop: Loop, frame: Frame, area: float | None) -> bool:
+    """Whether the replay joins the loop's curves into one closed wire (in world coordinates, as
+    the replay builds it: rounding there decides) whose face has ``area`` (when given: the face
+    is bounded by this loop alone)."""
+    from zonegraph.data.profiles import loop_face, new_snapper
+    from zonegraph.errors import DesignError
+
+    try:
+        built = loop_face(loop, frame, new_snapper(), "")
+    except (DesignError, ValueError, RuntimeError):
+        return False
+    return area is None or abs(float(built.area) - area) <= 1e-6 * abs(area)
 
 
 def wire_loops(face: Any, wire: Any, outer: bool) -> list[tuple[bool, list[Any]]]:
