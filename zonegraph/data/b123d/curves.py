@@ -143,7 +143,7 @@ def wire_loops(face: Any, wire: Any, outer: bool) -> list[tuple[bool, list[Any]]
     main = filled[0][0]
     out = [(outer, filled[0][1])]
     for piece_face, piece in filled[1:]:
-        common = main.intersect(piece_face) or []
+        common: Any = main.intersect(piece_face) or []
         inside = sum(f.area for f in common.faces()) if hasattr(common, "faces") else 0.0
         within = abs(inside - piece_face.area) <= 1e-6 * piece_face.area
         out.append((outer != within, piece))

@@ -59,7 +59,7 @@ def _inside(face: Any, container: Any) -> bool:
     from build123d import Face
 
     container = container if isinstance(container, Face) else Face(container)
-    common = container.intersect(face) or []
+    common: Any = container.intersect(face) or []
     inside = sum(f.area for f in common.faces()) if hasattr(common, "faces") else 0.0
     return abs(inside - face.area) <= 1e-9 * max(container.area, 1.0)
 
