@@ -60,6 +60,11 @@ class _Snapper:
         return p
 
 
+def new_snapper() -> _Snapper:
+    """A fresh snapper, for code outside this module that builds loops as the replay does."""
+    return _Snapper()
+
+
 def curve_edge(c: Curve, frame: Frame, snap: _Snapper) -> Edge:
     """One profile curve as a world-space edge."""
     if isinstance(c, Line):

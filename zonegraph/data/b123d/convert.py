@@ -22,6 +22,7 @@ from zonegraph.data.b123d.features import Plan, build_design, group_calls
 from zonegraph.data.b123d.loading import load_batch
 from zonegraph.data.b123d.reasons import one_line
 from zonegraph.data.b123d.recording import recording
+from zonegraph.data.b123d.reference import reference_part
 from zonegraph.data.b123d.verify import verify
 from zonegraph.data.design import design_to_json
 from zonegraph.errors import UnsupportedFeatureError
@@ -124,6 +125,8 @@ def _convert(  # noqa: C901 - the steps of one conversion, in order
         return result(Status.MODEL_RAISED, f"{type(exc).__name__}: {one_line(exc)}")
     if not isinstance(part, Shape) or part.wrapped is None or not part.solids():
         return result(Status.NO_SHAPE, f"the model returned {type(part).__name__} without a solid")
+    reference = reference_part(part)
+    part = reference.shape
     script_volume, script_area = float(part.volume), float(part.area)  # build123d's own measure
     if script_volume <= 0:
         return result(Status.NO_SHAPE, f"the model's part has volume {script_volume:.3g}")
@@ -134,7 +137,7 @@ def _convert(  # noqa: C901 - the steps of one conversion, in order
     start, end = batch.spans.get(fname, (0, 0))
     comments = feature_comments(batch.lines, start, end)
     features = group_calls(calls, comments)
-    notes: list[str] = []
+    notes: list[str] = [reference.note] if reference.note else []
     used = {id(f.comment) for f in features if f.comment is not None}
     idle = [f"{c.sketch} -> {c.name}" for c in comments if id(c) not in used]
     if idle:  # its sketch's faces stay pending and are extruded by the next call with the next ones
@@ -193,6 +196,8 @@ def _convert(  # noqa: C901 - the steps of one conversion, in order
             reason += (
                 f"; vs Fusion: replay {fv:.1e}/{fa:.1e}, script {script_fv:.1e}/{script_fa:.1e} (volume/area)"
             )
+        if not part.is_valid:
+            reason += "; the script's own part is an invalid solid"
         return result(check.status, reason, design_json=design_json, **common)
     if fv is not None and fa is not None and script_fv is not None and script_fa is not None:
         if min(max(fv, fa), max(script_fv, script_fa)) > FUSION_RTOL:

@@ -19,6 +19,7 @@ from zonegraph.errors import UnsupportedFeatureError
 from zonegraph.geometry.occ import precise_area
 
 PLANE_TOL = 1e-6  # cm: a profile point may sit this far off its sketch plane
+VERTEX_TOL = 1e-7  # cm: a wire's walk is back at a vertex it passed (OCC shares the vertex)
 
 
 @dataclass(frozen=True)
@@ -71,13 +72,14 @@ def face_record(face: Any, plane: Any) -> RecordedFace:
     wires = [(True, face.outer_wire())] + [(False, w) for w in face.inner_wires()]
     loops: list[Loop] = []
     dropped = 0
-    for outer, wire in wires:
-        curves = [edge_curve(e, local) for e in wire.edges()]
-        # The replay snaps end points closer than SNAP_TOL together, so such a line would collapse to
-        # a point (and fail); its neighbours are joined across the gap instead, as the replay does.
-        kept = [c for c in curves if not (isinstance(c, Line) and _length(c) < SNAP_TOL)]
-        dropped += len(curves) - len(kept)
-        loops.append(Loop(outer, tuple(kept)))
+    area = float(face.area) if len(wires) == 1 else None
+    for role, wire in wires:
+        whole = _loop(role, list(wire.edges()), local)
+        pieces = [whole] if _replay_keeps(whole[0], local.frame, area) else None
+        if pieces is None:  # a wire the replay cannot rebuild whole: its simple loops instead
+            pieces = [_loop(r, edges, local) for r, edges in wire_loops(face, wire, role)]
+        loops += [loop for loop, _ in pieces]
+        dropped += sum(n for _, n in pieces)
     normal = _v3(plane.z_dir)
     return RecordedFace(
         local.frame,
@@ -88,6 +90,99 @@ def face_record(face: Any, plane: Any) -> RecordedFace:
         float(face.area),
         dropped,
     )
+
+
+def _loop(outer: bool, edges: list[Any], local: _Local) -> tuple[Loop, int]:
+    """The edges as one loop of profile curves, and how many short lines it left out.
+
+    The replay snaps end points closer than SNAP_TOL together, so such a line would collapse to
+    a point (and fail); its neighbours are joined across the gap instead, as the replay does.
+    """
+    curves = [edge_curve(e, local) for e in edges]
+    kept = [c for c in curves if not (isinstance(c, Line) and _length(c) < SNAP_TOL)]
+    if not kept:  # the whole loop is smaller than the replay can draw
+        reason = f"a profile loop of {len(curves)} line(s), each shorter than {SNAP_TOL:g} cm"
+        raise UnsupportedFeatureError("", None, reason)
+    return Loop(outer, tuple(kept)), len(curves) - len(kept)
+
+
+def _replay_keeps(loop: Loop, frame: Frame, area: float | None) -> bool:
+    """Whether the replay joins the loop's curves into one closed wire (in world coordinates, as
+    the replay builds it: rounding there decides) whose face has ``area`` (when given: the face
+    is bounded by this loop alone)."""
+    from zonegraph.data.profiles import loop_face, new_snapper
+    from zonegraph.errors import DesignError, is_kernel_error
+
+    try:
+        built = loop_face(loop, frame, new_snapper(), "")
+    except DesignError:
+        return False
+    except Exception as exc:  # a curve the kernel cannot build: the replay reports it itself
+        if not is_kernel_error(exc):
+            raise
+        return True
+    return area is None or abs(float(built.area) - area) <= 1e-6 * abs(area)
+
+
+def wire_loops(face: Any, wire: Any, outer: bool) -> list[tuple[bool, list[Any]]]:
+    """A wire's edges as simple loops, each with its role (outer or hole).
+
+    OpenCASCADE accepts a wire that passes a vertex twice: a hole touching the outer boundary at
+    one point (a circle tangent to it) is walked as part of the outer wire. The replay joins each
+    loop into one closed wire, so such a wire is cut at its repeated vertices; the largest piece
+    keeps the wire's role, and a piece inside it bounds the opposite side (a hole of an outer wire).
+    A wire with no repeated vertex is returned as it is, edges in their own order.
+    """
+    from build123d import Edge, Face, Wire
+
+    pieces = _simple_cycles(face, wire)
+    if len(pieces) == 1:
+        return [(outer, list(wire.edges()))]
+    edges = [[Edge(e) for e in p] for p in pieces]
+    filled = sorted(((Face(Wire(p)), p) for p in edges), key=lambda fp: -fp[0].area)
+    main = filled[0][0]
+    out = [(outer, filled[0][1])]
+    for piece_face, piece in filled[1:]:
+        common: Any = main.intersect(piece_face) or []
+        inside = sum(f.area for f in common.faces()) if hasattr(common, "faces") else 0.0
+        within = abs(inside - piece_face.area) <= 1e-6 * piece_face.area
+        out.append((outer != within, piece))
+    return out
+
+
+def _simple_cycles(face: Any, wire: Any) -> list[list[Any]]:
+    """The wire's edges in walking order, cut into cycles wherever the walk returns to a vertex."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepTools import BRepTools_WireExplorer
+    from OCP.TopExp import TopExp
+
+    explorer = BRepTools_WireExplorer(wire.wrapped, face.wrapped)
+    walk = []
+    while explorer.More():
+        walk.append(explorer.Current())
+        explorer.Next()
+    if len(walk) < 2:
+        return [walk]
+
+    def end(edge: Any, last: bool) -> np.ndarray:
+        vertex = TopExp.LastVertex_s(edge, True) if last else TopExp.FirstVertex_s(edge, True)
+        return _v3(BRep_Tool.Pnt_s(vertex))
+
+    path = [end(walk[0], False)]
+    stack: list[Any] = []
+    cycles: list[list[Any]] = []
+    for edge in walk:
+        stack.append(edge)
+        v = end(edge, True)
+        hit = next((k for k, q in enumerate(path) if np.linalg.norm(v - q) <= VERTEX_TOL), None)
+        if hit is None:
+            path.append(v)
+            continue
+        cycles.append(stack[hit:])
+        del stack[hit:], path[hit + 1 :]
+    if stack:  # the walk did not close on its start: leave the wire whole
+        return [walk]
+    return cycles
 
 
 def face_area(face: Any) -> float | None:

@@ -1,7 +1,8 @@
 """Bridges between the scripts' build123d/OCP and ours: the scripts target build123d 0.10.
 
-``EllipticalCenterArc``'s old positional form is mapped onto the 0.13 signature, and the OCP 8
-array classes are aliased under their old names.
+``EllipticalCenterArc``'s old positional form is mapped onto the 0.13 signature, ``make_face`` on
+the curves of a slit profile builds the region Fusion meant (:mod:`.faces`), and the OCP 8 array
+classes are aliased under their old names.
 """
 
 from __future__ import annotations
@@ -9,6 +10,8 @@ from __future__ import annotations
 import inspect
 import types
 from typing import Any
+
+from zonegraph.data.b123d.faces import NotAProfile, slit_profile_faces
 
 
 def install_ocp_shims() -> None:
@@ -34,6 +37,7 @@ def install_api_shims(module: types.ModuleType) -> None:
     the old positional form raises. The shim maps the old arguments onto the new signature; the
     result is checked like everything else (replay vs script, script vs Fusion's volume and area).
     """
+    _install_make_face_shim(module)
     original = getattr(module, "EllipticalCenterArc", None)
     if original is None or "end_angle" in inspect.signature(original).parameters:
         return
@@ -64,3 +68,54 @@ def install_api_shims(module: types.ModuleType) -> None:
         )
 
     module.EllipticalCenterArc = elliptical_center_arc  # type: ignore[attr-defined]
+
+
+CLOSED_WIRES = "Face can only be created with closed wires"
+
+
+def _install_make_face_shim(module: types.ModuleType) -> None:
+    """``make_face`` that, where 0.13 refuses the open wire of a slit profile, builds its region.
+
+    Only that refusal is caught, so every face 0.13 builds itself stays as it was; the region is
+    checked like everything else (replay vs script, script vs Fusion's volume and area).
+    """
+    original = getattr(module, "make_face", None)
+    if original is None or getattr(original, "_zonegraph_shim", False):
+        return
+
+    def make_face(edges: Any = None, mode: Any = None) -> Any:
+        from build123d import Mode
+
+        mode = Mode.ADD if mode is None else mode
+        try:
+            return original(edges, mode=mode)
+        except ValueError as exc:
+            if str(exc) != CLOSED_WIRES:
+                raise
+            return _slit_make_face(edges, mode, exc)
+
+    make_face._zonegraph_shim = True  # type: ignore[attr-defined]
+    module.make_face = make_face  # type: ignore[attr-defined]
+
+
+def _slit_make_face(edges: Any, mode: Any, refusal: ValueError) -> Any:
+    """build123d's ``make_face`` steps with :func:`slit_profile_faces` as the face (the refusal
+    re-raised where the edges are not a slit profile either)."""
+    from build123d import BuildSketch, Compound, Curve, ShapeList, Sketch, Wire
+    from build123d.build_common import flatten_sequence
+
+    context = BuildSketch._get_context("make_face", log=False)
+    if edges is not None:
+        items = flatten_sequence(edges)
+        outer = [e for it in items for e in (it.edges() if isinstance(it, (Wire, Curve)) else [it])]
+    else:
+        outer = list(context.pending_edges) if context is not None else []
+    try:
+        faces = slit_profile_faces(outer)
+    except NotAProfile:
+        raise refusal from None
+    faces = [-f if f.normal_at().Z < 0 else f for f in faces]  # flip up-side-down faces, as make_face does
+    if context is not None:
+        context._add_to_context(*faces, mode=mode)
+        context.pending_edges = ShapeList()
+    return Sketch(Compound(faces).wrapped)
