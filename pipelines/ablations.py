@@ -4,7 +4,8 @@ and combined, ranked on held-out designs.
     python -m pipelines.ablations [--params params.yaml] [--variants base listwise features ...]
                                   [--rounds 0 1 2 3 4] [--designs 300] [--epochs 3]
                                   [--eval-designs 100] [--compare CHECKPOINT ...]
-                                  [--labels DIR] [--graphs DIR] [--out data/eval/ablations]
+                                  [--labels DIR] [--graphs DIR] [--eval-labels DIR --eval-graphs DIR]
+                                  [--out data/eval/ablations]
 
 A variant is a ``+``-joined list of changes to the ``train`` section of the params (the ``base``):
 ``focal`` / ``listwise`` (the objective), ``features`` / ``no_features`` (every proposal feature of
@@ -17,7 +18,9 @@ training run of ``training.train`` (MLflow experiment ``ablations``) on a seeded
 checkpoint and its config) is reused, so an interrupted ablation resumes. Every variant, random,
 the heuristic and the ``--compare`` checkpoints are then ranked on the same test designs, none of
 a project any of them trained on (``eval.heldout``), on every scale of ``eval.rank`` with 90%
-bootstrap intervals over designs. Writes ablations.md / .json / .png and ranks.parquet to ``--out``.
+bootstrap intervals over designs (``--eval-labels``: another run's test split, e.g. labels made
+at other code or from another sample). Writes ablations.md / .json / .png and ranks.parquet
+to ``--out``.
 """
 
 from __future__ import annotations
@@ -147,6 +150,10 @@ def main() -> None:
     parser.add_argument("--compare", nargs="*", default=[], help="other checkpoints ranked beside them")
     parser.add_argument("--labels", default=None, help="the labels folder (default: params)")
     parser.add_argument("--graphs", default=None, help="the zone graphs folder (default: params)")
+    parser.add_argument(
+        "--eval-labels", default=None, help="rank on these labels' test split (default: --labels)"
+    )
+    parser.add_argument("--eval-graphs", default=None, help="their zone graphs (default: --graphs)")
     parser.add_argument("--out", type=Path, default=Path("data/eval/ablations"))
     args = parser.parse_args()
     base = replace(
@@ -162,9 +169,10 @@ def main() -> None:
     models = [train_variant(name, config, args.out) for name, config in chosen.items()]
     compared = [Path(c) for c in args.compare]
     seen, _ = trained_projects([*models, *compared])
-    designs = held_out_labelled(base.labels_dir, "test", seen)[: args.eval_designs]
+    labels, graphs = args.eval_labels or base.labels_dir, args.eval_graphs or base.graphs_dir
+    designs = held_out_labelled(labels, "test", seen)[: args.eval_designs]
     guides = make_guides(["random", "heuristic"], [*models, *compared], base.seed)
-    ranks = guide_ranks(base.labels_dir, base.graphs_dir, guides, "test", designs)
+    ranks = guide_ranks(labels, graphs, guides, "test", designs)
     ranks.to_parquet(args.out / "ranks.parquet", index=False)
     table = summarise(ranks, seed=base.seed)
     ratio = ratios(ranks, seed=base.seed)
@@ -172,8 +180,8 @@ def main() -> None:
     costs = [{**trained(n, args.out / n), "settings": describe(c)} for n, c in chosen.items()]
     text = (
         f"## Ablations: GT rank on {ranks['design_id'].nunique()} held-out test designs\n\n"
-        f"(the first {len(designs)} by id of no project any network trained on; the others have no "
-        "step with a captured GT and another proposal)\n"
+        f"(`{labels}`: the first {len(designs)} by id of no project any network trained on; "
+        "the others have no step with a captured GT and another proposal)\n"
         f"Each network trained on {args.designs or 'all'} designs for {args.epochs} epochs "
         f"({base.points_per_zone} points per zone); the base is {describe(base)}.\n\n"
         + markdown(table, ratio)
@@ -182,6 +190,7 @@ def main() -> None:
     )
     (args.out / "ablations.md").write_text(text + "\n![ablations](ablations.png)\n")
     summary = {
+        "eval_labels": str(labels),
         "designs": len(designs),
         "epochs": args.epochs,
         "train_designs": args.designs or None,
