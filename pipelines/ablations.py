@@ -98,7 +98,7 @@ def train_variant(name: str, config: TrainConfig, out: Path) -> Path:
     stamp = folder / "config.json"
     wanted = json.dumps(asdict(config), sort_keys=True)
     checkpoint = folder / "scorer.pt"
-    if checkpoint.is_file() and stamp.is_file() and stamp.read_text() == wanted:
+    if checkpoint.is_file() and stamp.is_file() and same_settings(stamp.read_text(), wanted):
         print(f"ablations: {name}: reusing {checkpoint}", flush=True)
         return checkpoint
     print(f"ablations: {name}: training ({describe(config)})", flush=True)
@@ -107,6 +107,14 @@ def train_variant(name: str, config: TrainConfig, out: Path) -> Path:
     (folder / "train_s.json").write_text(json.dumps({"wall_s": time.perf_counter() - t0}))
     stamp.write_text(wanted)
     return checkpoint
+
+
+def same_settings(stamp: str, wanted: str) -> bool:
+    """Two variant configs alike but for their folder: a copied or moved ablation reuses its runs."""
+    first, second = json.loads(stamp), json.loads(wanted)
+    first.pop("out_dir", None)
+    second.pop("out_dir", None)
+    return bool(first == second)
 
 
 def describe(config: TrainConfig) -> str:
