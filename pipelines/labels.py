@@ -37,9 +37,8 @@ def saved_graph_rows(steps: pd.DataFrame) -> pd.DataFrame:
 
 def candidates(designs: pd.DataFrame, splits: list[str], limit: int | None, seed: int) -> pd.DataFrame:
     """Designs to label: the chosen splits, GT replayed to the target; a seeded stratified sample."""
-    reaches = designs["simplified_reaches_target"].where(
-        designs["simplified_status"] == Status.OK, designs["full_reaches_target"]
-    )
+    full = designs["full_reaches_target"] if "full_reaches_target" in designs else None  # full_graph: false
+    reaches = designs["simplified_reaches_target"].where(designs["simplified_status"] == Status.OK, full)
     chosen = designs[designs["split"].isin(splits) & (reaches == True)]  # noqa: E712 (nullable)
     chosen = chosen.sort_values("design_id").reset_index(drop=True)
     return chosen.iloc[stratified_sample(chosen["folder"].astype(str).tolist(), limit, seed)]

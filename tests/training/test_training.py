@@ -11,7 +11,7 @@ import torch
 from torch_geometric.loader import DataLoader
 
 from eval.heldout import held_out, trained_projects
-from pipelines.ablations import train_variant, variants
+from pipelines.ablations import default_specs, train_variant, variant, variants
 from training.card import card
 from training.data import LabelDataset
 from training.loss import focal_loss
@@ -254,6 +254,21 @@ def test_an_ablation_variant_trains_once_then_is_reused(labelled, tmp_path, monk
         "rounds0", replace(configs["rounds0"], lr=configs["rounds0"].lr * 10), tmp_path / "out"
     )
     assert other.stat().st_mtime_ns != written  # another config: trained again
+
+
+def test_an_ablation_variant_is_the_base_with_its_changes_each_alone_and_combined():
+    from zonegraph.sequence.features import FEATURES
+
+    base = TrainConfig(loss="focal", features=(), fusion="late", use_points=True, rounds=3)
+    combined = variant(base, "listwise+features+early+no_points+rounds1")
+    assert (combined.loss, combined.features, combined.fusion) == ("listwise", FEATURES, "early")
+    assert (combined.use_points, combined.rounds) == (False, 1)
+    assert variant(base, "base") == base and variant(combined, "focal").neutral_credit is None
+    specs = default_specs(base, [1, 3])
+    assert specs[:6] == ["base", "listwise", "features", "early", "no_points", "rounds1"]
+    assert "listwise+features+early" in specs and "rounds3" not in specs
+    with pytest.raises(SystemExit, match="unknown change 'deep'"):
+        variant(base, "listwise+deep")
 
 
 def test_listwise_loss_is_a_softmax_over_each_state_with_the_gt_as_target():

@@ -1,0 +1,187 @@
+"""What the network guide costs in search: exact rate and time to exact, heuristic vs network.
+
+    python -m bench.guide_cost_bench --graphs data/zonegraphs/graphs --gt data/gt
+        [--guides heuristic net=CHECKPOINT net=CHECKPOINT@top_m=8,blend=0.5 ...]
+        [--designs 20] [--budgets 1 5] [--seed 7] [--out bench_out/guide_cost]
+
+Searches the saved (simplified) zone graph of a seeded sample of test designs, stratified by
+timeline folder and none of a project any checkpoint trained on, once per guide and budget, in
+this one process (the ranker is made per design, so a network's per-graph encoding counts inside
+the budget, as in ``zonegraph infer``). A guide ``net=PATH@top_m=M,blend=B`` is the
+:class:`~zonegraph.network.ranker.NetworkRanker` with those knobs. Exact here is zone-exact (the
+search's own test, before the B-rep rebuild), so the figures isolate the search's ordering and
+scoring cost. On a shared machine wall seconds stretch with the load, so each search also records
+the process CPU seconds it used and its expansions (machine-independent). Writes
+``guide_cost.json`` (one row per design, guide and budget) and ``guide_cost.md`` to ``--out``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from eval.heldout import held_out, trained_projects
+from zonegraph.data.dataset import stratified_sample
+from zonegraph.network.ranker import NetworkRanker
+from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.sequence.proposals import ProposalGenerator
+from zonegraph.sequence.rankers import Ranker, make_ranker
+from zonegraph.zones.storage import load_zone_graph
+
+
+@dataclass(frozen=True)
+class GuideSpec:
+    """One guide of the comparison: ``heuristic``, ``random`` or ``net=PATH@top_m=M,blend=B``."""
+
+    label: str
+    name: str
+    model: str | None = None
+    top_m: int | None = None
+    blend: float | None = None
+
+    @classmethod
+    def parse(cls, spec: str) -> GuideSpec:
+        name, _, rest = spec.partition("=")
+        if name != "net":
+            return cls(spec, spec)
+        model, _, knobs = rest.partition("@")
+        options = dict(kv.split("=", 1) for kv in knobs.split(",") if kv)
+        unknown = set(options) - {"top_m", "blend"}
+        if unknown:
+            raise SystemExit(f"guide_cost_bench: {spec}: unknown option {sorted(unknown)} (top_m, blend)")
+        top_m = int(options["top_m"]) if "top_m" in options else None
+        blend = float(options["blend"]) if "blend" in options else None
+        label = f"net:{Path(model).parent.name or model}" + (f"@{knobs}" if knobs else "")
+        return cls(label, "net", model or None, top_m, blend)
+
+    def ranker(self, seed: int) -> Ranker:
+        if self.name != "net":
+            return make_ranker(self.name, seed)
+        return NetworkRanker(self.model, seed, top_m=self.top_m, blend=self.blend)
+
+
+def chosen_designs(gt: Path, graphs: Path, models: list[str], count: int, seed: int) -> pd.DataFrame:
+    """A seeded sample of ``count`` test designs with a saved graph, stratified by folder, none of a
+    project the checkpoints trained on; with their GT step counts."""
+    designs = pd.read_parquet(gt / "designs.parquet")
+    designs = designs[
+        (designs["split"] == "test") & designs["design_id"].map(lambda d: (graphs / d).is_dir())
+    ]
+    seen, _ = trained_projects(models) if models else (set(), [])
+    designs = designs[designs["design_id"].isin(held_out(designs["design_id"], seen))]
+    designs = designs.sort_values("design_id").reset_index(drop=True)
+    return designs.iloc[stratified_sample(designs["folder"].astype(str).tolist(), count, seed)]
+
+
+def one_search(graph: Any, guide: GuideSpec, budget: float, seed: int) -> dict[str, Any]:
+    ranker = guide.ranker(seed)
+    cpu, wall = time.process_time(), time.perf_counter()
+    result = search(graph, ranker, SearchConfig(budget_s=budget), ProposalGenerator(graph))
+    return {
+        "exact": bool(result.exact),
+        "time_to_exact_s": result.time_to_best_s if result.exact else None,
+        "search_wall_s": time.perf_counter() - wall,
+        "search_cpu_s": time.process_time() - cpu,
+        "expansions": result.expansions,
+        "iou": result.iou,
+    }
+
+
+def summary(rows: pd.DataFrame) -> pd.DataFrame:
+    """Per guide and budget: exact counts over designs (all, GT >= 3) and median time to exact on
+    the designs every guide solved at that budget."""
+    out = []
+    for budget, at in rows.groupby("budget"):
+        solved = at.groupby("design_id")["exact"].all()
+        common = set(solved[solved].index)
+        for guide, group in at.groupby("guide", sort=False):
+            long = group[group["gt_steps"] >= 3]
+            both = group[group["design_id"].isin(common)]
+            out.append(
+                {
+                    "budget_s": budget,
+                    "guide": guide,
+                    "exact": int(group["exact"].sum()),
+                    "designs": len(group),
+                    "exact_gt3": int(long["exact"].sum()),
+                    "designs_gt3": len(long),
+                    "common": len(both),
+                    "median_time_to_exact_s": float(np.median(both["time_to_exact_s"]))
+                    if len(both)
+                    else None,
+                    "median_search_cpu_s": float(np.median(both["search_cpu_s"])) if len(both) else None,
+                    "median_expansions": float(np.median(both["expansions"])) if len(both) else None,
+                }
+            )
+    return pd.DataFrame(out)
+
+
+def markdown(table: pd.DataFrame) -> str:
+    lines = [
+        "| budget s | guide | exact | exact, GT >= 3 | median time to exact s (wall) | median search CPU s | "
+        "median expansions |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in table.itertuples():
+        tail = "| | | |"
+        if r.common:
+            medians = (r.median_time_to_exact_s, r.median_search_cpu_s)
+            tail = f"| {medians[0]:.3f} | {medians[1]:.3f} | {r.median_expansions:.0f} |"
+        head = f"| {r.budget_s:g} | {r.guide} | {r.exact}/{r.designs} | {r.exact_gt3}/{r.designs_gt3} "
+        lines.append(head + tail)
+    common = ", ".join(f"{b:g} s: {n}" for b, n in table.groupby("budget_s")["common"].first().items())
+    return "\n".join(lines) + f"\n\nMedians over the designs every guide solved at that budget ({common}).\n"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--graphs", type=Path, required=True, help="the zonegraphs stage's graphs folder")
+    parser.add_argument("--gt", type=Path, required=True, help="the ground_truth stage's folder")
+    parser.add_argument("--guides", nargs="+", default=["heuristic", "net"])
+    parser.add_argument("--designs", type=int, default=20)
+    parser.add_argument("--budgets", type=float, nargs="+", default=[1.0, 5.0])
+    parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))
+    args = parser.parse_args()
+    guides = [GuideSpec.parse(g) for g in args.guides]
+    models = [g.model for g in guides if g.model]
+    designs = chosen_designs(args.gt, args.graphs, models, args.designs, args.seed)
+    print(
+        f"guide_cost_bench: {len(designs)} designs: {designs['folder'].value_counts().sort_index().to_dict()}"
+    )
+    rows = []
+    for i, design in enumerate(designs.itertuples(), 1):
+        graph = load_zone_graph(args.graphs / design.design_id, solids=False)
+        for budget in args.budgets:
+            for guide in guides:
+                found = one_search(graph, guide, budget, args.seed)
+                rows.append(
+                    {"design_id": design.design_id, "gt_steps": int(design.steps), "zones": graph.n_zones}
+                    | {"guide": guide.label, "budget": budget, **found}
+                )
+        done = [r for r in rows if r["design_id"] == design.design_id]
+        print(
+            f"[{i}/{len(designs)}] {design.design_id}: "
+            + ", ".join(f"{r['guide']}@{r['budget']:g} {'exact' if r['exact'] else '-'}" for r in done),
+            flush=True,
+        )
+    frame = pd.DataFrame(rows)
+    table = summary(frame)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "guide_cost.json").write_text(
+        json.dumps({"rows": rows, "summary": table.to_dict(orient="records")}, indent=2, default=str)
+    )
+    text = markdown(table)
+    (args.out / "guide_cost.md").write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
