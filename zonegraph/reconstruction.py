@@ -99,7 +99,8 @@ class InferResult:
     zones: int
     simplified: bool
     expansions: int
-    script_snapped: bool = False  # sequence.py/.json carry snapped numbers (they rebuilt as well)
+    script_snapped: bool = False  # sequence.py carries snapped numbers (it rebuilt as well)
+    json_snapped: bool = False  # sequence.json carries snapped numbers (it rebuilt as well)
     snapped_numbers: int = 0  # numbers written shorter than the raw program's
     script_iou: float = 0.0  # B-rep IoU of the written sequence.py, run as written
     json_iou: float = 0.0  # B-rep IoU of the written sequence.json, replayed by our reader
@@ -260,6 +261,7 @@ def _export_fields(export: Export | None) -> dict[str, Any]:
         return {}
     return {
         "script_snapped": export.snapped,
+        "json_snapped": export.design_snapped,
         "snapped_numbers": export.snapped_numbers,
         "script_iou": export.check.script_iou,
         "json_iou": export.check.json_iou,
