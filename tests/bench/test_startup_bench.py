@@ -37,8 +37,8 @@ def test_measure_sees_the_childs_memory_and_cpu_and_exit_status(tmp_path):
 
 
 def test_the_original_is_skipped_with_a_reason_and_the_table_has_medians(tmp_path):
-    assert "no --original" in original_problem(None, sys.executable)
-    assert "not a brownvc/zone-graphs checkout" in original_problem(tmp_path, sys.executable)
+    assert "no --original" in original_problem(None, sys.executable, [])
+    assert "not a brownvc/zone-graphs checkout" in original_problem(tmp_path, sys.executable, [])
     run = {"rc": 0, "cpu_s": 1.0, "wall_s": 2.0, "peak_mb": 250.0}
     rows = [{"part": p, "step_bytes": n, "build": run} for p, n in (("a", 10), ("b", 5))]
     text = table(rows, ["build"], "because")
