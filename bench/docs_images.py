@@ -40,7 +40,7 @@ from build123d import (
 
 import zonegraph as zg
 from zonegraph.export.render import render_zone_graph
-from zonegraph.testing.mlflow_server import free_port, rest
+from zonegraph.testing.mlflow_server import mlflow_server, rest
 
 
 def bracket(path: Path) -> Path:
@@ -114,16 +114,7 @@ def _shoot(address: str, height: int, path: Path) -> None:
 def mlflow_shots(project: Path, out: Path) -> list[Path]:
     """Serve ``project``'s store with ``mlflow ui`` and photograph :data:`SHOTS` into ``out``."""
     subprocess.run([sys.executable, "-m", "eval.tracking", "relocate"], cwd=project, check=True)
-    port = free_port()
-    server = subprocess.Popen(
-        [sys.executable, "-m", "mlflow", "ui", "--backend-store-uri", "sqlite:///mlflow.db"]
-        + ["--host", "127.0.0.1", "--port", str(port), "--workers", "1"],
-        cwd=project,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    try:
-        base = f"http://127.0.0.1:{port}"
+    with mlflow_server(project, command="ui") as base:
         rest(base, "experiments/search", {"max_results": 1})  # the server is up
         ids = _ids(base)
         paths = []
@@ -137,9 +128,6 @@ def mlflow_shots(project: Path, out: Path) -> list[Path]:
             paths.append(out / name)
             print(f"wrote {out / name} ({(out / name).stat().st_size // 1024} KB)", flush=True)
         return paths
-    finally:
-        server.terminate()
-        server.wait(timeout=30)
 
 
 def main() -> None:

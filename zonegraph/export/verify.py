@@ -210,18 +210,12 @@ def _mixed(snapped: Export, raw: Export, floor: float) -> Export:
         s_error = _file_error(snapped.check.error, label)
         files.append(not s_error and _no_worse(s_iou, r_iou, floor))
     script_from, design_from = (snapped if use else raw for use in files)
-    check = ExportCheck(
-        script_from.check.script_iou,
-        design_from.check.json_iou,
-        "; ".join(
-            e
-            for e in (
-                _file_error(script_from.check.error, "sequence.py"),
-                _file_error(design_from.check.error, "sequence.json"),
-            )
-            if e
-        ),
+    errors = (
+        _file_error(script_from.check.error, "sequence.py"),
+        _file_error(design_from.check.error, "sequence.json"),
     )
+    error = "; ".join(filter(None, errors))
+    check = ExportCheck(script_from.check.script_iou, design_from.check.json_iou, error)
     return Export(
         script_from.script,
         design_from.design,

@@ -345,14 +345,14 @@ def _step_code(i: int, step: WrittenStep, unit: str, style: ScriptStyle) -> list
     verb = "union" if step.op is Op.UNION else "subtract"
     plane, where, direction = _where(step, unit)
     depth = f"{written(abs(step.distance))} {unit}"
+    mode = "Mode.ADD" if step.op is Op.UNION else "Mode.SUBTRACT"
     if style.fuzzy:
         what = f"{verb}: sketch on {where}, extruded {depth} {direction}"
-        return _fuzzy_step_code(i, step, plane, what, style)
+        return _fuzzy_step_code(i, step, plane, what, mode, style)
     circles = _hole_circles(step) if style.holes else None
     if circles is not None:
         count = f"{len(circles)} holes" if len(circles) > 1 else "a hole"
         return [f"    # Step {i}: {count} {depth} deep into {where}", *_hole_code(step, circles, plane), ""]
-    mode = "Mode.ADD" if step.op is Op.UNION else "Mode.SUBTRACT"
     return [
         f"    # Step {i}: {verb}: sketch on {where}, extruded {depth} {direction}",
         f"    with BuildSketch({plane}):",
@@ -399,10 +399,11 @@ def boolean(part, tool, mode):
 """
 
 
-def _fuzzy_step_code(i: int, step: WrittenStep, plane: str, what: str, style: ScriptStyle) -> list[str]:
+def _fuzzy_step_code(
+    i: int, step: WrittenStep, plane: str, what: str, mode: str, style: ScriptStyle
+) -> list[str]:
     """A step in build123d's algebra mode: the sketch extruded alone, then :data:`FUZZY_CODE`'s
     ``boolean`` with the part so far."""
-    mode = "Mode.ADD" if step.op is Op.UNION else "Mode.SUBTRACT"
     return [
         f"# Step {i}: {what}",
         f"with BuildSketch({plane}) as sketch:",

@@ -20,11 +20,12 @@ def free_port() -> int:
 
 
 @contextlib.contextmanager
-def mlflow_server(cwd: Path) -> Iterator[str]:
-    """Serve ``cwd/mlflow.db`` (artifacts under ``cwd/mlartifacts``); yields the server's URL."""
+def mlflow_server(cwd: Path, command: str = "server") -> Iterator[str]:
+    """Serve ``cwd/mlflow.db`` (artifacts under ``cwd/mlartifacts``) by ``mlflow server`` (or
+    ``command``, e.g. ``ui``); yields the server's URL."""
     port = free_port()
     server = subprocess.Popen(
-        [sys.executable, "-m", "mlflow", "server", "--backend-store-uri", "sqlite:///mlflow.db"]
+        [sys.executable, "-m", "mlflow", command, "--backend-store-uri", "sqlite:///mlflow.db"]
         + ["--host", "127.0.0.1", "--port", str(port), "--workers", "1"],
         cwd=cwd,
         stdout=subprocess.DEVNULL,
