@@ -125,7 +125,7 @@ def describe(config: TrainConfig) -> str:
 
 def trained(name: str, folder: Path) -> dict[str, Any]:
     """What one variant's training cost and reached (its best epoch's validation metrics)."""
-    metrics = json.loads((folder / "metrics.json").read_text()) if (folder / "metrics.json").is_file() else {}
+    metrics = json.loads((folder / "best.json").read_text()) if (folder / "best.json").is_file() else {}
     cost = json.loads((folder / "train_s.json").read_text()) if (folder / "train_s.json").is_file() else {}
     keys = ("epoch", "val_normalised", "val_rank", "val_top1", "val_steps")
     return {"variant": name, "train_wall_s": cost.get("wall_s"), **{k: metrics.get(k) for k in keys}}

@@ -9,8 +9,10 @@ gives neutral proposals partial credit); ``train.features`` names the proposal f
 scorer reads beside the zones (:mod:`zonegraph.sequence.features`). Every epoch logs the
 training and validation loss and the validation GT rank on every scale (rank / P, its floor,
 the normalised rank, top-1 and top-5; ``docs/evaluation.md``). The checkpoint with the best
-validation normalised rank is written to ``models/scorer.pt`` with ``models/metrics.json``;
-``models/curve.csv`` and ``models/curve.png`` hold the learning curves.
+validation normalised rank is written to ``models/scorer.pt``, its every figure to
+``models/best.json``; ``models/metrics.json`` holds the few keys ``dvc metrics show`` shares with
+the stages (:func:`dvc_metrics`); ``models/curve.csv`` and ``models/curve.png`` hold the learning
+curves.
 
 A run resumes: every epoch also writes ``models/last.pt`` (weights, optimiser, the shuffle's
 random state, the curve so far, the MLflow run), and a run started with the same settings and
@@ -331,7 +333,7 @@ def _alive(pid: int) -> bool:
 
 def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     """One training run, or the rest of an interrupted one; returns the best epoch's metrics
-    (also in ``out_dir/metrics.json``)."""
+    (also in ``out_dir/best.json``)."""
     import mlflow  # a heavy import: only when training
 
     config.check()
@@ -425,7 +427,8 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
         if not curve:
             raise SystemExit("train: no epoch finished with a finite loss; no checkpoint written")
         write_curves(curve, out)
-        (out / "metrics.json").write_text(json.dumps({**best, "run_id": run.info.run_id}, indent=2))
+        (out / "best.json").write_text(json.dumps({**best, "run_id": run.info.run_id}, indent=2))
+        (out / "metrics.json").write_text(json.dumps(dvc_metrics(best, curve, len(train_ids)), indent=2))
         mlflow.log_metrics({metric_name(f"best_{k}"): v for k, v in best.items() if k != "epoch"})
         mlflow.log_artifact(str(out / "scorer.pt"))
         log_scorer(out / "scorer.pt")
@@ -476,6 +479,17 @@ def save_checkpoint(
         },
         path,
     )
+
+
+def dvc_metrics(best: dict[str, Any], curve: list[dict], designs: int) -> dict[str, Any]:
+    """The training's row of ``dvc metrics show``: only keys the stages' files also use
+    (``eval/dvc_metrics.py``: designs, seconds, rank), so the unfiltered table gains no column;
+    ``seconds`` is the median epoch, ``rank`` the best epoch's validation rank / P."""
+    seconds = sorted(r["seconds"] for r in curve)
+    mid = len(seconds) // 2
+    median = seconds[mid] if len(seconds) % 2 else (seconds[mid - 1] + seconds[mid]) / 2
+    rank = best["val_rank"] if np.isfinite(best["val_rank"]) else None
+    return {"designs": designs, "seconds": round(median, 3), "rank": None if rank is None else round(rank, 3)}
 
 
 def write_curves(curve: list[dict], out: Path) -> None:

@@ -153,8 +153,10 @@ def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_pat
         device="cpu",
     )
     best = train(config)
-    metrics = json.loads((tmp_path / "models" / "metrics.json").read_text())
+    metrics = json.loads((tmp_path / "models" / "best.json").read_text())
     assert metrics["epoch"] == best["epoch"] and 0 < metrics["val_rank"] <= 1
+    shared = json.loads((tmp_path / "models" / "metrics.json").read_text())
+    assert set(shared) == {"designs", "seconds", "rank"} and shared["rank"] == round(best["val_rank"], 3)
     assert (tmp_path / "models" / "curve.png").stat().st_size > 1000
     assert load_scorer(tmp_path / "models" / "scorer.pt").training is False
     checkpoint = torch.load(tmp_path / "models" / "scorer.pt", weights_only=True)
@@ -345,6 +347,6 @@ def test_a_stopped_run_resumes_from_its_last_epoch_in_the_same_mlflow_run(labell
     client = mlflow.tracking.MlflowClient(tracking_uri="sqlite:///mlflow.db")
     history = client.get_metric_history(broken["run_id"], "val/normalised")
     assert sorted(m.step for m in history) == [1, 2]  # one MLflow run across the interruption
-    assert json.loads((tmp_path / "broken" / "metrics.json").read_text())["run_id"] == broken["run_id"]
+    assert json.loads((tmp_path / "broken" / "best.json").read_text())["run_id"] == broken["run_id"]
     train(replace(base, out_dir="broken", lr=0.01), fresh=False)  # other settings: a new run
     assert torch.load(tmp_path / "broken" / "last.pt", weights_only=True)["run_id"] != broken["run_id"]
