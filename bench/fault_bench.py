@@ -42,7 +42,7 @@ import signal
 import threading
 import warnings
 from collections import defaultdict
-from dataclasses import dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -492,6 +492,13 @@ def main() -> None:
     args = p.parse_args()
     table = run_bench(args.designs, args.trials, args.seed, args.out.resolve(), tuple(args.kinds), args.cycle)
     print(format_table(table))
+    write_results(table, args.out / "results.json")
+
+
+def write_results(tallies: dict[str, Tally], path: Path) -> None:
+    """The tallies by kind, for ``python -m bench.figures fault`` (the docs' table)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps({kind: asdict(t) for kind, t in sorted(tallies.items())}, indent=1) + "\n")
 
 
 def _kill_trial(

@@ -6,6 +6,7 @@
     python -m bench.figures conversion NAME data/details/conversion.json --command "..."
     python -m bench.figures fuzz NAME DIR/rows.json --command "python -m bench.fuzz_bench ..."
     python -m bench.figures verify NAME DIR/results.json --command "python -m bench.verify_bench ..."
+    python -m bench.figures fault NAME DIR/results.json --command "python -m bench.fault_bench ..."
 
 A results page never carries a number typed by hand: a benchmark's ``results.json`` (its per-design
 rows, or its summary) is reduced here to a small figure file, ``docs/figures/NAME.json``, holding
@@ -133,7 +134,22 @@ def verify_figure(rows: list[dict]) -> dict:
     }
 
 
+TALLY = ("faults", "survived", "lost", "stale", "wrong", "damaged", "detected")
+
+
+def fault_figure(tallies: dict[str, dict]) -> dict:
+    """The fault benchmark's tallies by kind and over all kinds (its notes name each failed
+    trial)."""
+    by_kind = {k: {n: int(t[n]) for n in TALLY} for k, t in sorted(tallies.items())}
+    return {
+        "by_kind": by_kind,
+        "all": {n: sum(t[n] for t in by_kind.values()) for n in TALLY},
+        "notes": [n for t in tallies.values() for n in t.get("notes", [])],
+    }
+
+
 FIGURES_OF = {
+    "fault": fault_figure,
     "corpus": corpus_figure,
     "conversion": conversion_figure,
     "fuzz": fuzz_figure,

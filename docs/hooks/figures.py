@@ -165,7 +165,30 @@ def verify(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def fault(records: list[dict]) -> str:
+    """The fault benchmark: faults by kind, survived, records lost, stale or wrong, and the
+    corruptions detected among the stored files damaged."""
+    (r,) = records
+    f = r["figure"]
+
+    def row(kind: str, t: dict) -> str:
+        detected = f"{t['detected']}/{t['damaged']}" if t["damaged"] else "-"
+        cells = [str(t[n]) for n in ("faults", "survived", "lost", "stale", "wrong")]
+        return f"| {kind} | " + " | ".join(cells) + f" | {detected} |"
+
+    lines = [
+        "| fault | faults | survived | lost | stale | wrong | corruptions detected |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+        *(row(k, t) for k, t in f["by_kind"].items()),
+        row("all", f["all"]),
+    ]
+    if f["notes"]:
+        lines += ["", "Trials not survived:", "", *(f"- {n}" for n in f["notes"])]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
 RENDERERS: dict[str, Callable[[list[dict]], str]] = {
+    "fault": fault,
     "verify": verify,
     "corpus-exact": corpus_exact,
     "fusion-diff": fusion_diff,

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from bench.figures import conversion_figure, corpus_figure, fuzz_figure
+from bench.fault_bench import Tally, write_results
+from bench.figures import conversion_figure, corpus_figure, fault_figure, fuzz_figure
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -98,6 +99,20 @@ def test_conversion_and_fuzz_figures_count_from_the_stage_and_bench_outputs():
     record = {"name": "n", "command": "c", "commit": "abc1234", "measured": "today"}
     assert "| user_error | 2 | 0 | 2 |" in hook.fuzz([{**record, "figure": z}])
     assert "**3/4 (75.0%)" in hook.conversion([{**record, "figure": f}])
+
+
+def test_the_fault_figure_totals_the_benchs_tallies_and_names_failed_trials(tmp_path):
+    tallies = {
+        "truncate": Tally(faults=3, survived=3, damaged=3, detected=3),
+        "kill_child": Tally(faults=2, survived=1, wrong=1, notes=["trial 4: a record differs"]),
+    }
+    write_results(tallies, tmp_path / "results.json")
+    f = fault_figure(json.loads((tmp_path / "results.json").read_text()))
+    assert f["all"]["faults"] == 5 and f["all"]["survived"] == 4 and f["all"]["detected"] == 3
+    record = {"name": "n", "command": "c", "commit": "abc1234", "measured": "today", "figure": f}
+    table = _hook().fault([record])
+    assert "| all | 5 | 4 | 0 | 0 | 1 | 3/3 |" in table and "| kill_child | 2 | 1 | 0 | 0 | 1 | - |" in table
+    assert "- trial 4: a record differs" in table
 
 
 def test_every_results_table_is_drawn_from_a_figure_or_marked_as_typed():
