@@ -32,7 +32,8 @@ from zonegraph.status import Status
 FIGURES = Path("docs/figures")
 EXACT_IOU = 0.9999
 SEARCHED = (Status.EXACT, Status.PARTIAL, Status.REBUILD_FAILED)
-USER_ERROR = re.compile(r"error: \S+: ([a-z_]+): ")
+# "zonegraph: error: PATH: STATUS: reason", convert's "PATH: DESIGN: STATUS: reason"
+USER_ERROR = re.compile(r"error: \S+: (?:\S+: )?([a-z_]+): ")
 
 
 def _group(rows: list[dict]) -> dict:
@@ -88,11 +89,15 @@ def conversion_figure(details: dict) -> dict:
 def fuzz_figure(rows: list[dict]) -> dict:
     """The fuzz benchmark's outcomes by command, the user errors by status and the slowest input,
     from its ``rows.json``."""
+    from zonegraph.testing.fuzz import OUTCOMES  # needs hypothesis: only for this figure
+
     commands = sorted({r["command"] for r in rows})
-    outcomes = sorted({r["outcome"] for r in rows})
+    outcomes = [o for o in OUTCOMES if o in {r["outcome"] for r in rows}] + [
+        o for o in OUTCOMES if o not in {r["outcome"] for r in rows}
+    ]
     statuses: dict[str, int] = {}
     for r in rows:
-        if r["outcome"] == "user_error":  # "zonegraph: error: PATH: STATUS: reason"
+        if r["outcome"] == "user_error":
             found = USER_ERROR.search(str(r.get("detail", "")))
             key = found.group(1) if found else "other"
             statuses[key] = statuses.get(key, 0) + 1

@@ -115,6 +115,12 @@ def conversion(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def _outcome_order(outcome: str) -> tuple[int, str]:
+    """The contract's outcomes first, then the violations (a figure file sorts its keys)."""
+    kept = ("success", "user_error", "timeout")
+    return (kept.index(outcome) if outcome in kept else len(kept), outcome)
+
+
 def fuzz(records: list[dict]) -> str:
     """The fuzz benchmark's outcomes by command, one column per command."""
     (r,) = records
@@ -125,7 +131,7 @@ def fuzz(records: list[dict]) -> str:
         "|---|---:|" + "---:|" * len(commands),
         *(
             f"| {o} | {sum(counts.values())} | " + " | ".join(str(counts.get(c, 0)) for c in commands) + " |"
-            for o, counts in f["by_outcome"].items()
+            for o, counts in sorted(f["by_outcome"].items(), key=lambda kv: _outcome_order(kv[0]))
         ),
         "",
         f"{f['inputs']} inputs; user errors by status: "
