@@ -65,6 +65,7 @@ from zonegraph.isolation import Outcome
 from zonegraph.jobs import build_and_save, ground_truth_and_coverage, label_and_save
 from zonegraph.outputs import run_staged
 from zonegraph.status import Status
+from zonegraph.testing.batches import block_model, plate_model
 from zonegraph.zones.storage import load_zone_graph
 
 CONFIG = BuildConfig(samples=16)
@@ -85,30 +86,12 @@ STAGES = ("replay", "graphs", "labels")
 CONVERT_TIMEOUT_S = 8.0  # the looping model's timeout (the good ones are reused, never rerun)
 CONVERT_MEMORY_MB = 1024  # the allocating model's limit
 
-GOOD_MODELS = """from build123d import *
+
+def good_models(prefix: str) -> str:
+    """A batch of two good models, ``model_<prefix>plate`` and ``model_<prefix>block``."""
+    return "from build123d import *\n" + plate_model(f"{prefix}plate") + block_model(f"{prefix}block")
 
 
-def model_{p}plate():
-    with BuildPart() as part:
-        # Sketch1 -> Extrude1 (NewBody)
-        with BuildSketch(Plane.XY):
-            Rectangle(4, 2)
-        extrude(amount=1)
-        # Sketch2 -> Extrude2 (Cut)
-        with BuildSketch(Plane(origin=(0, 0, 1), x_dir=(1, 0, 0), z_dir=(0, 0, 1))):
-            Circle(0.5)
-        extrude(amount=-1, mode=Mode.SUBTRACT)
-    return part.part
-
-
-def model_{p}block():
-    with BuildPart() as part:
-        # Sketch1 -> Extrude1 (NewBody)
-        with BuildSketch(Plane.XY):
-            Rectangle(3, 3)
-        extrude(amount=2)
-    return part.part
-"""
 HOSTILE_MODELS = {
     "convert_loop": "def model_spins():\n    while True:\n        pass\n",
     "convert_alloc": (
@@ -425,7 +408,7 @@ def _reason(record: dict) -> str:
 def _hostile_batch(kind: str, rng: np.random.Generator) -> bytes:
     if kind in HOSTILE_MODELS:  # a batch imports build123d (the converter records its extrude)
         return f"from build123d import *\n\n\n{HOSTILE_MODELS[kind]}".encode()
-    text = GOOD_MODELS.format(p="h_").encode()
+    text = good_models("h_").encode()
     if kind == "convert_truncate":
         return text[: int(rng.integers(0, len(text)))]
     return _garbled(text, rng)
@@ -470,7 +453,7 @@ def _convert_reference(root: Path, client: Client) -> tuple[Path, dict]:
     reference = root / "convert-reference"
     folder = reference / "corpus" / "01_2ops"
     folder.mkdir(parents=True)
-    (folder / "batch_001.py").write_text(GOOD_MODELS.format(p=""))
+    (folder / "batch_001.py").write_text(good_models(""))
     ref, _ = convert_project(reference, client)
     bad = {d: _reason(r) for d, r in ref.items() if _status(r) != Status.OK}
     if bad:

@@ -10,41 +10,17 @@ worker) say nothing about the design: they are recorded but tried again on later
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 from pathlib import Path
 from typing import Any
 
+from zonegraph.outputs import FileHashes, hash_output
 from zonegraph.status import Status
 
 RECORD_VERSION = 2  # records without it predate output hashes (see :func:`reuse`)
 MAX_ATTEMPTS = 3  # runs on which an environment failure is tried before it stands as final
 TRANSIENT = frozenset({Status.TIMEOUT, Status.CRASH, Status.WORKER_ERROR, Status.OUT_OF_MEMORY})
-
-FileHashes = dict[str, list[Any]]  # file name relative to its output -> [size, sha1]
-
-
-def _files(path: Path) -> list[Path]:
-    if path.is_file():
-        return [path]
-    if not path.is_dir():
-        return []
-    return sorted(f for f in path.rglob("*") if f.is_file() and "__pycache__" not in f.parts)
-
-
-def hash_output(path: str | Path) -> FileHashes:
-    """Every file of an output (one file or a folder) with its size and SHA-1; empty when absent."""
-    root = Path(path)
-    hashes: FileHashes = {}
-    for f in _files(root):
-        digest = hashlib.sha1()
-        with open(f, "rb") as stream:
-            for block in iter(lambda: stream.read(1 << 20), b""):
-                digest.update(block)
-        name = "." if f == root else str(f.relative_to(root))
-        hashes[name] = [f.stat().st_size, digest.hexdigest()]
-    return hashes
 
 
 def hash_outputs(outputs: tuple[str, ...]) -> list[FileHashes]:

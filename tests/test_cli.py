@@ -17,6 +17,7 @@ from zonegraph.cli import main
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.geometry.shapes import read_solids
+from zonegraph.testing.batches import PLATE_AREA, PLATE_VOLUME, plate_model
 
 SCRIPT = Path(sys.executable).parent / "zonegraph"
 ROOT = Path(__file__).resolve().parents[1]  # run as ``python -m zonegraph.cli`` from here: this checkout
@@ -45,28 +46,16 @@ def test_replay_writes_steps_and_summary(samples_dir, tmp_path):
     assert sum(s.volume for s in final) == pytest.approx(summary["volume"] * 1000, rel=1e-6)
 
 
-BATCH = """
+BATCH = f"""
 from build123d import *
-
-def model_1_a_0000():
-    with BuildPart() as part:
-        # Sketch1 -> Extrude1 (NewBody)
-        with BuildSketch(Plane.XY):
-            Rectangle(4, 2)
-        extrude(amount=1)
-        # Sketch2 -> Extrude2 (Cut)
-        with BuildSketch(Plane(origin=(0, 0, 1), x_dir=(1, 0, 0), z_dir=(0, 0, 1))):
-            Circle(0.5)
-        extrude(amount=-1, mode=Mode.SUBTRACT)
-    return part.part
-
+{plate_model("1_a_0000")}
 def model_1_b_0000():
     raise RuntimeError("broken model")
 
-MODELS = {
-    "model_1_a_0000": {"func": model_1_a_0000, "volume": 7.2146018366, "area": 29.5707963268},
-    "model_1_b_0000": {"func": model_1_b_0000, "volume": 1.0, "area": 1.0},
-}
+MODELS = {{
+    "model_1_a_0000": {{"func": model_1_a_0000, "volume": {PLATE_VOLUME}, "area": {PLATE_AREA}}},
+    "model_1_b_0000": {{"func": model_1_b_0000, "volume": 1.0, "area": 1.0}},
+}}
 """
 
 

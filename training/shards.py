@@ -12,13 +12,14 @@ alone) keeps every pair of shards whose Parquet footers read.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import pyarrow.parquet as pq
+
+from zonegraph.outputs import hash_output
 
 KINDS = ("proposals", "steps")
 
@@ -37,14 +38,6 @@ class LabelShards:
 
     def of(self, kind: str) -> list[Path]:
         return self.proposals if kind == "proposals" else self.steps
-
-
-def _sha1(path: Path) -> list[object]:
-    digest = hashlib.sha1()
-    with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return [path.stat().st_size, digest.hexdigest()]
 
 
 def _readable(path: Path) -> bool:
@@ -72,7 +65,7 @@ def _record_problem(root: Path, design_id: str) -> str | None:
         if listed is None:  # a record from before output hashes: the footer must read
             if not _readable(shard):
                 return f"{kind}/{shard.name} is not a readable Parquet file"
-        elif {".": _sha1(shard)} not in listed:
+        elif hash_output(shard) not in listed:
             return f"{kind}/{shard.name} differs from its record (size or SHA-1)"
     return None
 

@@ -12,11 +12,15 @@ One run writes into an ``--out`` at a time: a second one finds its lock (``.OUT.
 an ``flock`` the kernel drops when the holder dies, removed when the run ends) and refuses in one
 line, instead of two runs mixing their files. Whoever holds the lock also removes the scratch
 folders that killed runs left.
+
+:func:`hash_output` is the one definition of an output's content (each file's size and SHA-1):
+the pipeline's records name their outputs with it and training checks label shards against it.
 """
 
 from __future__ import annotations
 
 import fcntl
+import hashlib
 import json
 import os
 import shutil
@@ -24,12 +28,13 @@ import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 from zonegraph.errors import ZoneGraphError
 from zonegraph.isolation import Outcome
 
 LISTING = ".zonegraph-outputs.json"
+FileHashes = dict[str, list[Any]]  # file name relative to its output -> [size, sha1]
 
 
 def run_staged(run: Callable[[Path], Outcome], out: Path) -> Outcome:
@@ -123,3 +128,25 @@ def _write_record(out: Path, name: str, text: str) -> None:
     out.mkdir(parents=True, exist_ok=True)
     (out / name).write_text(text)
     (out / LISTING).write_text(json.dumps({"names": [name]}))
+
+
+def _files(path: Path) -> list[Path]:
+    if path.is_file():
+        return [path]
+    if not path.is_dir():
+        return []
+    return sorted(f for f in path.rglob("*") if f.is_file() and "__pycache__" not in f.parts)
+
+
+def hash_output(path: str | Path) -> FileHashes:
+    """Every file of an output (one file or a folder) with its size and SHA-1; empty when absent."""
+    root = Path(path)
+    hashes: FileHashes = {}
+    for f in _files(root):
+        digest = hashlib.sha1()
+        with open(f, "rb") as stream:
+            for block in iter(lambda: stream.read(1 << 20), b""):
+                digest.update(block)
+        name = "." if f == root else str(f.relative_to(root))
+        hashes[name] = [f.stat().st_size, digest.hexdigest()]
+    return hashes

@@ -12,21 +12,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+from zonegraph.testing.batches import plate_model
+
 ROOT = Path(__file__).resolve().parents[2]
 
-OK_MODEL = """
-def model_good():
-    with BuildPart() as part:
-        # Sketch1 -> Extrude1 (NewBody)
-        with BuildSketch(Plane.XY):
-            Rectangle(4, 2)
-        extrude(amount=1)
-        # Sketch2 -> Extrude2 (Cut)
-        with BuildSketch(Plane(origin=(0, 0, 1), x_dir=(1, 0, 0), z_dir=(0, 0, 1))):
-            Circle(0.5)
-        extrude(amount=-1, mode=Mode.SUBTRACT)
-    return part.part
-"""
+OK_MODEL = plate_model("good")
 
 HOSTILE_MODELS = """
 def model_exits():
