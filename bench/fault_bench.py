@@ -52,7 +52,7 @@ from distributed import Client
 
 from pipelines.cluster import dask_client
 from pipelines.generate import convert_to_json
-from pipelines.params import DaskParams
+from pipelines.params import DaskParams, LabelsParams, ReplayParams, ZoneGraphParams
 from pipelines.records import hash_output, is_transient
 from pipelines.replay import replay_design
 from pipelines.runner import Job, code_fingerprint, fingerprint, run_jobs
@@ -83,6 +83,13 @@ FILE_FAULTS = ("truncate", "garble", "delete")
 CONVERT_FAULTS = ("convert_truncate", "convert_garbage", "convert_loop", "convert_alloc", "convert_exit")
 KINDS = ("kill_child", "kill_worker", *FILE_FAULTS, "writers", *CONVERT_FAULTS)
 STAGES = ("replay", "graphs", "labels")
+# The stages' own defaults (params.yaml's): a limit tighter than the pipeline's would count a slow
+# job on a loaded machine (a 414-zone design labels in 70 s beside other work) as a lost record.
+STAGE_TIMEOUTS_S = {
+    "replay": ReplayParams().timeout_s,
+    "graphs": ZoneGraphParams().timeout_s,
+    "labels": LabelsParams().timeout_s,
+}
 CONVERT_TIMEOUT_S = 8.0  # the looping model's timeout (the good ones are reused, never rerun)
 CONVERT_MEMORY_MB = 1024  # the allocating model's limit
 
@@ -205,7 +212,7 @@ def run_project(
     before = {p: p.stat().st_mtime_ns for p in _record_files(project)}
     out: dict[str, Any] = {}
     todo, ok = designs, {}
-    for stage, timeout in zip(STAGES, (60, 120, 120), strict=True):
+    for stage, timeout in STAGE_TIMEOUTS_S.items():
         jobs = _jobs(project, stage, todo, kill or {}, ok)
         out[stage] = run_jobs(_killing, jobs, records_dir(project, stage), client, timeout, stage)
         ok[stage] = {r["design_id"]: r for r in out[stage] if r["status"] == Status.OK}
@@ -232,7 +239,8 @@ def compare(project: Path, reference: Path, ref: dict, now: dict) -> tuple[int, 
             where = f"{stage}/{r['design_id']}"
             if m is None or m["status"] != Status.OK:
                 lost += r["status"] == Status.OK
-                which += [f"{where}: lost"] if r["status"] == Status.OK else []
+                said = f"{m['status']}: {m.get('reason', '')}" if m else "no record"
+                which += [f"{where}: lost ({said})"] if r["status"] == Status.OK else []
                 continue
             if _values(m) != _values(r):
                 wrong += 1
