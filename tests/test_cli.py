@@ -162,11 +162,14 @@ def test_help_and_argument_errors_load_no_geometry_kernel(tmp_path):
     assert "no such file" in proc.stderr and "unknown guide 'nope'" in proc.stderr
 
 
-@pytest.mark.parametrize("budget", ["0", "-1", "nan"])
-def test_a_budget_that_is_not_positive_is_a_user_error(samples_dir, tmp_path, budget):
-    proc = _cli("infer", str(samples_dir / "Couch.json"), "--out", str(tmp_path / "o"), f"--budget={budget}")
+@pytest.mark.parametrize(
+    ("flag", "value"), [("--budget", "0"), ("--budget", "-1"), ("--budget", "nan"), ("--expansions", "0")]
+)
+def test_a_bound_that_is_not_positive_is_a_user_error(samples_dir, tmp_path, flag, value):
+    proc = _cli("infer", str(samples_dir / "Couch.json"), "--out", str(tmp_path / "o"), f"{flag}={value}")
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
-    message = f"zonegraph: error: --budget {float(budget)}: must be a positive number"
+    shown = float(value) if flag == "--budget" else int(value)
+    message = f"zonegraph: error: {flag} {shown}: must be a positive number"
     assert proc.stderr.strip().splitlines() == [message]
     assert not (tmp_path / "o").exists()
 

@@ -106,9 +106,9 @@ def test_classes_of_made_up_runs(tmp_path):
     assert got["all_at_once"][1] == ["traceback", "noise", "partial_output"]
 
 
-PROBE = '''
+PROBE = """
 PROBE = ("a-literal-no-module-had", 987654, 31337, 7, 12, b"zz", -3, 2.5)
-'''
+"""
 
 DRAW = """
 import hashlib, sys

@@ -44,8 +44,7 @@ def test_shared_beside_the_package_checkout_else(tmp_path):
 
 def test_import_zonegraph_testing_needs_no_pytest():
     code = (
-        "import sys, zonegraph, zonegraph.testing; zonegraph.testing.SAMPLES; "
-        "print('pytest' in sys.modules)"
+        "import sys, zonegraph, zonegraph.testing; zonegraph.testing.SAMPLES; print('pytest' in sys.modules)"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False"]

@@ -424,6 +424,13 @@ def _add_infer(sub: Any) -> None:
         "--level", type=int, default=d["level"], help="proposal level (subsets of sketch components)"
     )
     p.add_argument(
+        "--expansions",
+        dest="max_expansions",
+        type=int,
+        default=None,
+        help="states expanded per graph searched at most (a bound the same on any machine)",
+    )
+    p.add_argument(
         "--timeout",
         type=float,
         default=None,
@@ -489,6 +496,7 @@ def _add_memory(p: argparse.ArgumentParser) -> None:
 # Arguments that must be positive where a command has them (0 or less ran a search of no steps).
 POSITIVE = {
     "budget_s": "--budget",
+    "max_expansions": "--expansions",
     "timeout": "--timeout",
     "k": "--k",
     "max_depth": "--max-depth",

@@ -170,6 +170,8 @@ class InferConfig(Config):
         level: proposal level: sketches of 1..level and N-level..N components.
         model: the network guide's checkpoint (None: the shipped one); the built-in guides use
             none, so the CLI refuses one with them.
+        max_expansions: a work bound per graph searched (states expanded), None for none; with an
+            infinite ``budget_s`` it makes a reconstruction the same on any machine and load.
     """
 
     guide: str = "heuristic"
@@ -180,3 +182,4 @@ class InferConfig(Config):
     seed: int = 0
     level: int = 1
     model: str | None = None
+    max_expansions: int | None = None

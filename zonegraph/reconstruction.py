@@ -219,9 +219,9 @@ def reconstruct(
             continue
         build_s += seconds
         share = (config.budget_s - search_s) * budget_share(graph, simplify)
-        deadline = Deadline.after(share)  # the generator's set-up counts against the budget
+        deadline, start = Deadline.after(share), time.perf_counter()  # set-up counts against it
         gen = ProposalGenerator(graph, level=config.level)
-        setup = share - deadline.left()
+        setup = time.perf_counter() - start
         settings = {**asdict(config), "budget_s": share - setup}
         result = search(graph, ranker, SearchConfig.from_mapping(settings), gen, deadline)
         if best is None or (result.iou, -len(result.steps)) > (best[2].iou, -len(best[2].steps)):

@@ -21,7 +21,7 @@ import numpy as np
 from zonegraph.configs import Config
 from zonegraph.sequence.deadline import Deadline
 from zonegraph.sequence.proposals import Proposal, ProposalGenerator
-from zonegraph.sequence.rankers import Ranker, score_step, zone_iou
+from zonegraph.sequence.rankers import Ranker, score_step, zone_exact, zone_iou
 from zonegraph.zones.model import ZoneGraph
 
 
@@ -38,7 +38,7 @@ class SearchConfig(Config):
             machine, so seeded runs bounded by it are reproducible.
 
     ``zonegraph infer`` derives it from its :class:`~zonegraph.configs.InferConfig` (which holds
-    every field but ``max_expansions``) with ``SearchConfig.from_mapping(asdict(infer_config))``.
+    every field of it) with ``SearchConfig.from_mapping(asdict(infer_config))``.
     """
 
     k: int = 5
@@ -129,7 +129,7 @@ def search(
         return iter([props[i] for i in order])
 
     stack = [_Frame(empty, [], expand(empty, []))]
-    exact = bool(np.array_equal(empty, target))
+    exact = zone_exact(graph, empty, target)
     ended = "exhausted"
     while stack and not exact:
         if deadline.passed():
@@ -154,7 +154,7 @@ def search(
             best = (iou, len(path), canvas, path)
             time_to_best = time.perf_counter() - t0
             trace.append((time_to_best, iou))
-        if np.array_equal(canvas, target):
+        if zone_exact(graph, canvas, target):
             exact = True
             break
         if len(path) < config.max_depth:
