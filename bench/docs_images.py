@@ -39,6 +39,7 @@ from build123d import (
 )
 
 import zonegraph as zg
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.export.render import render_zone_graph
 from zonegraph.testing.mlflow_server import mlflow_server, rest
 

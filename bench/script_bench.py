@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 from build123d import Pos, Unit
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from bench.corpus import write_results
 from bench.proposal_bench import DESIGNS, EXCLUDE, draw
 from zonegraph.data.design import Design, ExtentType, Extrude, Operation, Sketch, load_design

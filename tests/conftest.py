@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+import zonegraph.geometry.kernel  # noqa: F401 - before any test's Boolean, as the package does
 from zonegraph.testing import SAMPLES, SKIP_REASON
 
 

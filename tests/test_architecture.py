@@ -108,6 +108,19 @@ def test_the_package_and_the_cli_help_load_no_torch():
     assert out.split() == ["[]"]
 
 
+def test_every_module_that_imports_the_kernel_holds_its_thread_pool_first():
+    """A parallel Boolean before the pool is held would hang every forked child's first one."""
+    kernel = "zonegraph.geometry.kernel"
+    bad = [
+        module
+        for module, path in _modules()
+        if module != kernel
+        and any(i.split(".")[0] in ("OCP", "build123d") for i in _eager_imports(path))
+        and kernel not in _eager_imports(path)
+    ]
+    assert not bad, f"import {kernel} in:\n" + "\n".join(sorted(bad))
+
+
 def test_imports_run_one_way():
     bad = []
     for module, path in _modules():

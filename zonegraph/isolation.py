@@ -23,6 +23,7 @@ import signal
 import sys
 import time
 import traceback
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
@@ -178,6 +179,27 @@ def _died(exitcode: int | None, memory_mb: int | None, seconds: float) -> Outcom
     return Outcome(Status.CRASH, reason=reason, seconds=seconds)
 
 
+def _warn_if_pool_started() -> None:
+    """Warn, once, when the kernel's thread pool has a worker thread a child would wait for (a
+    parallel Boolean ran before :mod:`zonegraph.geometry.kernel` was imported)."""
+    global _POOL_CHECKED
+    if _POOL_CHECKED or "OCP" not in sys.modules:
+        return
+    _POOL_CHECKED = True
+    from zonegraph.geometry.kernel import fork_safe
+
+    if not fork_safe():
+        warnings.warn(
+            "OpenCASCADE's thread pool started before zonegraph was imported: forked jobs may hang "
+            "until their timeout; import zonegraph.geometry.kernel before any build123d Boolean",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+
+
+_POOL_CHECKED = False
+
+
 def _fork(proc: BaseProcess) -> None:
     """Start the child with every object inherited from the parent frozen (``gc.freeze``).
 
@@ -185,6 +207,7 @@ def _fork(proc: BaseProcess) -> None:
     OCP, scipy), writing to each one's header and so copying its page: measured on ``zonegraph
     infer`` of a one-extrude part, 0.2 s of collection and 0.5 s per part instead of 0.13 s. The
     parent unfreezes at once, so its own garbage is still collected."""
+    _warn_if_pool_started()
     gc.freeze()
     try:
         proc.start()

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 from build123d import Part, Shape, Solid, Unit
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.configs import InferConfig
 from zonegraph.data.replay import as_shape
 from zonegraph.data.targets import load_target

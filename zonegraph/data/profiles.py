@@ -18,6 +18,7 @@ from OCP.GC import GC_MakeArcOfEllipse
 from OCP.Geom import Geom_BSplineCurve
 from OCP.gp import gp_Ax2, gp_Dir, gp_Elips, gp_Pnt
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.data.design import (
     Arc,
     Circle,

@@ -19,6 +19,7 @@ from build123d import Compound, Face, Pos, Shape, Solid, Vector
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.data.design import Design, ExtentType, Extrude, Operation, Sketch
 from zonegraph.data.profiles import profile_faces
 from zonegraph.errors import DesignError, ReplayError, is_kernel_error

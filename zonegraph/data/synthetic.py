@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from build123d import Face, GeomType, Shape, Solid, Vector
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.configs import Config
 from zonegraph.data.design import (
     Arc,

@@ -20,6 +20,7 @@ from OCP.BRepTools import BRepTools_WireExplorer
 from OCP.TopAbs import TopAbs_REVERSED
 from OCP.TopExp import TopExp
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.data.profiles import SNAP_TOL
 
 # An open edge whose corners are closer than this is left out of a written loop: the JSON reader

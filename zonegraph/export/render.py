@@ -19,6 +19,7 @@ from OCP.BRepMesh import BRepMesh_IncrementalMesh  # noqa: E402
 from OCP.TopAbs import TopAbs_FACE  # noqa: E402
 from OCP.TopoDS import TopoDS_Shape  # noqa: E402
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.geometry.occ import face_triangles, sub_shapes  # noqa: E402
 from zonegraph.sequence.program import ProgramStep  # noqa: E402
 from zonegraph.sequence.proposals import Op  # noqa: E402

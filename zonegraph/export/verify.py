@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from build123d import Shape, Unit
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay
 from zonegraph.export.snap import REL_TOL, Snapper

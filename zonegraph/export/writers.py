@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 from build123d import Face, GeomType, Shape, Unit, Vector
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.data.design import (
     Arc,
     Circle,

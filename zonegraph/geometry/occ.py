@@ -27,6 +27,8 @@ from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
+
 
 def pnt(p: Sequence[float] | np.ndarray) -> gp_Pnt:
     return gp_Pnt(float(p[0]), float(p[1]), float(p[2]))

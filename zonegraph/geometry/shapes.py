@@ -22,6 +22,7 @@ from OCP.STEPControl import STEPControl_Reader
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_ShapeEnum, TopAbs_SOLID
 from OCP.TopoDS import TopoDS_Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.console import captured
 from zonegraph.errors import InputError, require_file
 from zonegraph.geometry.occ import precise_volume, sub_shapes

@@ -28,6 +28,7 @@ from OCP.GeomAbs import GeomAbs_C0, GeomAbs_SurfaceType
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_ShapeEnum
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.geometry.occ import AncestorMap, ancestors, shape_index, surface_props, xyz
 from zonegraph.sequence.deadline import Deadline
 from zonegraph.sequence.proposals import ProposalGenerator

@@ -22,6 +22,7 @@ from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
 from OCP.TopAbs import TopAbs_IN, TopAbs_ON, TopAbs_SOLID
 from OCP.TopoDS import TopoDS_Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.geometry.occ import pnt, sub_shapes, volume_props
 from zonegraph.sequence.proposals import Op, ProposalGenerator
 from zonegraph.zones.model import ZoneGraph

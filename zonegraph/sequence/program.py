@@ -21,6 +21,7 @@ from OCP.Precision import Precision
 from OCP.ShapeFix import ShapeFix_Shape, ShapeFix_ShapeTolerance
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SHAPE, TopAbs_SOLID
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.errors import is_kernel_error
 from zonegraph.geometry.cells import FUZZY_SHARES, cells_by_fuzzy
 from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, precise_volume

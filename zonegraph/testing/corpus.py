@@ -9,6 +9,7 @@ import functools
 
 from build123d import Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.data.b123d import convert_design
 from zonegraph.data.design import parse_design
 from zonegraph.data.replay import replay

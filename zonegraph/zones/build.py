@@ -28,6 +28,7 @@ from OCP.IntTools import IntTools_Context
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_IN, TopAbs_INTERNAL, TopAbs_REVERSED, TopAbs_SOLID
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.geometry.normalize import Normalization
 from zonegraph.geometry.occ import (
     ShapeList,

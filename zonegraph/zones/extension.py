@@ -26,6 +26,7 @@ from OCP.gp import gp_Ax3, gp_Cylinder, gp_Pln
 from OCP.TopAbs import TopAbs_FACE, TopAbs_VERTEX
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.geometry.occ import direction, pnt, shape_index, sub_shapes, surface_props, xyz
 from zonegraph.zones.face_loops import LoopRule, find_face_loops
 

@@ -29,6 +29,7 @@ from OCP.GeomAbs import GeomAbs_Line, GeomAbs_Plane
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.geometry.occ import ShapeIndex, make_compound, shape_index, sub_shapes, xyz
 
 PARALLEL_TOL = 1e-9  # 1 - |cos| between edge directions

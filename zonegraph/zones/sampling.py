@@ -18,6 +18,7 @@ import numpy as np
 from OCP.BRepMesh import BRepMesh_IncrementalMesh
 from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.geometry.occ import face_triangles, make_compound, sub_shapes
 
 if TYPE_CHECKING:

@@ -21,6 +21,7 @@ from OCP.BRepTools import BRepTools
 from OCP.TopAbs import TopAbs_SOLID
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 
+import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.errors import InputError
 from zonegraph.geometry.normalize import Normalization
 from zonegraph.geometry.occ import make_compound, sub_shapes
