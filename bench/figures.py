@@ -7,6 +7,7 @@
     python -m bench.figures fuzz NAME DIR/rows.json --command "python -m bench.fuzz_bench ..."
     python -m bench.figures verify NAME DIR/results.json --command "python -m bench.verify_bench ..."
     python -m bench.figures fault NAME DIR/results.json --command "python -m bench.fault_bench ..."
+    python -m bench.figures build|search|replay NAME DIR/results.json --command "python -m bench..."
 
 A results page never carries a number typed by hand: a benchmark's ``results.json`` (its per-design
 rows, or its summary) is reduced here to a small figure file, ``docs/figures/NAME.json``, holding
@@ -137,6 +138,76 @@ def verify_figure(rows: list[dict]) -> dict:
     }
 
 
+def _spread(values: list[float], scale: float = 1.0, digits: int = 4) -> dict | None:
+    """Median, 90th percentile and maximum of ``values`` times ``scale`` (None when empty)."""
+    if not values:
+        return None
+    a = scale * np.asarray(values, float)
+    figures = (np.median(a), np.percentile(a, 90), a.max())
+    return {k: round(float(v), digits) for k, v in zip(("median", "p90", "max"), figures, strict=True)}
+
+
+def build_figure(rows: list[dict]) -> dict:
+    """The zone-graph build benchmark by design set and graph: built of drawn, build seconds and
+    zone counts, and every failure with its status."""
+    groups = {}
+    for name in sorted({r["set"] for r in rows}):
+        for simplified in (True, False):
+            group = [r for r in rows if r["set"] == name and r["simplified"] == simplified]
+            built = [r for r in group if r["status"] == Status.OK]
+            groups[f"{name}, {'simplified' if simplified else 'full'}"] = {
+                "designs": len(group),
+                "built": len(built),
+                "build_s": _spread([r["build_s"] for r in built]),
+                "zones": _spread([r["zones"] for r in built], digits=0),
+                "failed": {r["design"]: r["status"] for r in group if r["status"] != Status.OK},
+            }
+    return {"groups": groups}
+
+
+def search_figure(rows: list[dict]) -> dict:
+    """The search benchmark by design set: exact of searched (and of drawn), proposals per state,
+    milliseconds per expansion, seconds to exact and the designs not exact."""
+    sets = {}
+    for name in sorted({r["set"] for r in rows}):
+        drawn = [r for r in rows if r["set"] == name]
+        searched = [r for r in drawn if "skipped" not in r]
+        exact = [r for r in searched if r["exact"]]
+        slowest = max(searched, key=lambda r: max(r["expansion_s"] or [0.0]), default=None)
+        sets[name] = {
+            "drawn": len(drawn),
+            "searched": len(searched),
+            "exact": len(exact),
+            "expansions": sum(len(r["expansion_s"]) for r in searched),
+            "proposals_per_state": _spread([n for r in searched for n in r["proposals_per_state"]], digits=0),
+            "ms_per_expansion": _spread([t for r in searched for t in r["expansion_s"]], 1e3, 2),
+            "s_to_exact": _spread([r["time_to_best_s"] for r in exact]),
+            "not_exact": sorted(r["design"] for r in searched if not r["exact"]),
+            "slowest_expansion": None
+            if slowest is None
+            else {"design": slowest["design"], "zones": slowest["zones"]},
+            "budget_s": searched[0]["budget_s"] if searched else None,
+            "guide": searched[0]["guide"] if searched else None,
+        }
+    return {"sets": sets}
+
+
+def replay_figure(rows: list[dict]) -> dict:
+    """The replay benchmark by design set: milliseconds per design and per extrude step."""
+    sets = {}
+    for name in sorted({r["set"] for r in rows}):
+        group = [r for r in rows if r["set"] == name]
+        slowest = max(group, key=lambda r: r["seconds"])
+        sets[name] = {
+            "designs": len(group),
+            "steps": sum(len(r["step_s"]) for r in group),
+            "ms_per_design": _spread([r["seconds"] for r in group], 1e3, 2),
+            "ms_per_step": _spread([t for r in group for t in r["step_s"]], 1e3, 2),
+            "slowest": {"design": slowest["design"], "steps": len(slowest["step_s"])},
+        }
+    return {"sets": sets}
+
+
 TALLY = ("faults", "survived", "lost", "stale", "wrong", "damaged", "detected")
 
 
@@ -152,6 +223,9 @@ def fault_figure(tallies: dict[str, dict]) -> dict:
 
 
 FIGURES_OF = {
+    "build": build_figure,
+    "search": search_figure,
+    "replay": replay_figure,
     "fault": fault_figure,
     "corpus": corpus_figure,
     "conversion": conversion_figure,

@@ -1,14 +1,18 @@
 """Proposals per state and time per search expansion (proposal generation + ranking).
 
-    python -m bench.search_bench [--synthetic N] [--budget S] [--guide heuristic|random]
+    python -m bench.search_bench [--synthetic N] [--budget S] [--guide heuristic|random] [--out DIR]
 
 Runs the search on the simplified zone graph of each real sample and of N synthetic designs
-(single process) and prints the median and worst figures, plus time to the best canvas.
+(single process) and prints the median and worst figures, plus time to the best canvas; writes a
+row per design (with its proposals per state and seconds per expansion) to ``--out/results.json``
+(``python -m bench.figures search`` draws the documentation's table from it).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+from pathlib import Path
 
 import numpy as np
 
@@ -23,14 +27,16 @@ from zonegraph.testing import SAMPLES
 from zonegraph.zones.build import build_zone_graph
 
 
-def run(name: str, designs, budget: float, guide: str, max_zones: int) -> None:
-    props, times, per_design = [], [], []
+def run(name: str, designs, budget: float, guide: str, max_zones: int) -> list[dict]:
+    props, times, per_design, rows = [], [], [], []
     for design in designs:
         try:
             graph = build_zone_graph(list(replay(design).bodies), samples=0)
-        except ZoneGraphError:
+        except ZoneGraphError as exc:
+            rows.append({"set": name, "design": design.id, "skipped": f"no zone graph: {exc}"})
             continue
         if graph.n_zones > max_zones:
+            rows.append({"set": name, "design": design.id, "skipped": f"{graph.n_zones} zones > --max-zones"})
             continue
         result = search(graph, make_ranker(guide), SearchConfig(budget_s=budget), ProposalGenerator(graph))
         props += result.proposals_per_state
@@ -38,6 +44,25 @@ def run(name: str, designs, budget: float, guide: str, max_zones: int) -> None:
         per_design.append(
             (design.id, graph.n_zones, result.exact, result.time_to_best_s, max(result.expansion_s or [0]))
         )
+        rows.append(
+            {
+                "set": name,
+                "design": design.id,
+                "zones": graph.n_zones,
+                "exact": result.exact,
+                "ended": result.ended,
+                "time_to_best_s": result.time_to_best_s,
+                "proposals_per_state": result.proposals_per_state,
+                "expansion_s": result.expansion_s,
+                "guide": guide,
+                "budget_s": budget,
+            }
+        )
+    _print(name, guide, budget, props, times, per_design)
+    return rows
+
+
+def _print(name: str, guide: str, budget: float, props: list, times: list, per_design: list) -> None:
     p, t = np.array(props), 1e3 * np.array(times)
     exact = sum(d[2] for d in per_design)
     print(
@@ -67,17 +92,17 @@ def main() -> None:
     parser.add_argument(
         "--max-zones", type=int, default=2000, help="skip larger graphs (their build dominates)"
     )
+    parser.add_argument("--out", type=Path, default=Path("bench_out/search"))
     args = parser.parse_args()
+    rows = []
     if SAMPLES.is_dir():
-        run(
-            "real samples",
-            [load_design(p) for p in sorted(SAMPLES.glob("*.json"))],
-            args.budget,
-            args.guide,
-            args.max_zones,
-        )
+        samples = [load_design(p) for p in sorted(SAMPLES.glob("*.json"))]
+        rows += run("samples", samples, args.budget, args.guide, args.max_zones)
     synthetic = (synthetic_design(i) for i in range(args.synthetic))
-    run("synthetic", synthetic, args.budget, args.guide, args.max_zones)
+    rows += run("synthetic", synthetic, args.budget, args.guide, args.max_zones)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "results.json").write_text(json.dumps(rows, indent=1))
+    print(f"\nwrote {args.out / 'results.json'}")
 
 
 if __name__ == "__main__":

@@ -1,15 +1,18 @@
 """Zone graph build time, zone count and face count on the real samples and synthetic designs,
 simplified and not.
 
-    python -m bench.zonegraph_bench [--synthetic N] [--workers 2] [--timeout 120]
+    python -m bench.zonegraph_bench [--synthetic N] [--workers 2] [--timeout 120] [--out DIR]
 
 Each design is built in its own process under a timeout (one core each; ``--workers`` run side
-by side). Prints medians, the slowest designs and every failure with its status and reason.
+by side). Prints medians, the slowest designs and every failure with its status and reason, and
+writes a row per design and graph to ``--out/results.json`` (``python -m bench.figures build``
+draws the documentation's table from it).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -70,18 +73,42 @@ def report(name: str, results: list[tuple[str, bool, Outcome]]) -> None:
                 print(f"  FAILED {Path(s).stem}: {o.status}: {o.reason}")
 
 
+def rows(name: str, results: list[tuple[str, bool, Outcome]]) -> list[dict]:
+    """One results row per design and graph: its set, status, and build figures when built."""
+    out = []
+    for source, simplify, o in results:
+        row = {"set": name, "design": Path(source).stem, "simplified": simplify, "status": o.status}
+        if o.ok:
+            row |= {
+                "build_s": o.value["build_s"],
+                "zones": o.value["zones"],
+                "faces": o.value["target_faces"],
+            }
+        else:
+            row["reason"] = o.reason
+        out.append(row)
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--synthetic", type=int, default=300)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--timeout", type=float, default=120.0)
+    parser.add_argument("--out", type=Path, default=Path("bench_out/zonegraph"))
     args = parser.parse_args()
     samples = [str(p) for p in sorted(SAMPLES.glob("*.json"))] if SAMPLES.is_dir() else []
     synthetic = [f"synthetic:{i}" for i in range(args.synthetic)]
+    written: list[dict] = []
     with ProcessPoolExecutor(args.workers) as pool:
-        for name, sources in (("real samples", samples), ("synthetic", synthetic)):
+        for name, sources in (("samples", samples), ("synthetic", synthetic)):
             jobs = [(s, simp, args.timeout) for s in sources for simp in (True, False)]
-            report(name, list(pool.map(_job, jobs, chunksize=2)))
+            results = list(pool.map(_job, jobs, chunksize=2))
+            report(name, results)
+            written += rows(name, results)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "results.json").write_text(json.dumps(written, indent=1))
+    print(f"\nwrote {args.out / 'results.json'}")
 
 
 if __name__ == "__main__":

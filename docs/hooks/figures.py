@@ -193,7 +193,76 @@ def fault(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def _three(spread: dict | None, digits: int = 3) -> str:
+    """``median / p90 / max`` of a figure's spread (``-`` when nothing was measured)."""
+    if spread is None:
+        return "-"
+    return " / ".join(f"{spread[k]:,.{digits}f}" for k in ("median", "p90", "max"))
+
+
+def build(records: list[dict]) -> str:
+    """Zone-graph builds by design set and graph: built of drawn, seconds, zones, failures."""
+    (r,) = records
+    groups = r["figure"]["groups"]
+    lines = [
+        "| designs | built | build s median / p90 / max | zones median / p90 / max |",
+        "|---|---|---|---|",
+        *(
+            f"| {name} | {_rate(g['built'], g['designs'])} | {_three(g['build_s'])} | "
+            f"{_three(g['zones'], 0)} |"
+            for name, g in groups.items()
+        ),
+    ]
+    failed = [f"`{d}` ({name}: {status})" for name, g in groups.items() for d, status in g["failed"].items()]
+    if failed:
+        lines += ["", "Not built: " + ", ".join(failed) + "."]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def search(records: list[dict]) -> str:
+    """Searches by design set: exact, proposals per state, milliseconds per expansion, seconds to
+    exact, with the designs not exact."""
+    (r,) = records
+    sets = r["figure"]["sets"]
+    lines = [
+        "| designs | exact, of searched | proposals per state | ms per expansion | s to exact |",
+        "|---|---|---|---|---|",
+        *(
+            f"| {name} ({g['searched']} of {g['drawn']} searched, {g['guide']}, {g['budget_s']:g} s) | "
+            f"{_rate(g['exact'], g['searched'])} | {_three(g['proposals_per_state'], 0)} | "
+            f"{_three(g['ms_per_expansion'], 2)} | {_three(g['s_to_exact'])} |"
+            for name, g in sets.items()
+        ),
+        "",
+        "Each cell is median / p90 / max. "
+        + " ".join(
+            f"Not exact in {name}: {', '.join(f'`{d}`' for d in g['not_exact']) or 'none'}."
+            for name, g in sets.items()
+        ),
+    ]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def replay(records: list[dict]) -> str:
+    """Replays by design set: milliseconds per design and per extrude step, the slowest design."""
+    (r,) = records
+    sets = r["figure"]["sets"]
+    lines = [
+        "| designs | steps | ms per design median / p90 / max | ms per step median / p90 / max | slowest |",
+        "|---|---|---|---|---|",
+        *(
+            f"| {name} ({g['designs']}) | {g['steps']} | {_three(g['ms_per_design'], 1)} | "
+            f"{_three(g['ms_per_step'], 1)} | `{g['slowest']['design']}` ({g['slowest']['steps']} steps) |"
+            for name, g in sets.items()
+        ),
+    ]
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
 RENDERERS: dict[str, Callable[[list[dict]], str]] = {
+    "build": build,
+    "search": search,
+    "replay": replay,
     "fault": fault,
     "verify": verify,
     "corpus-exact": corpus_exact,

@@ -129,3 +129,28 @@ def test_every_results_table_is_drawn_from_a_figure_or_marked_as_typed():
                 assert after.startswith("<!-- typed:"), (
                     f"{page.name}: a typed table without its commit: {block[:80]}"
                 )
+
+
+def test_build_search_and_replay_figures_come_from_the_benches_rows():
+    """The three timing benches on synthetic designs: their rows, reduced and rendered."""
+    from bench import replay_bench, search_bench, zonegraph_bench
+    from bench.figures import build_figure, replay_figure, search_figure
+    from zonegraph.data.synthetic import synthetic_design
+
+    designs = [synthetic_design(i) for i in range(3)]
+    jobs = [(f"synthetic:{i}", simplify, 60.0) for i in range(3) for simplify in (True, False)]
+    built = build_figure(zonegraph_bench.rows("synthetic", [zonegraph_bench._job(j) for j in jobs]))
+    searched = search_figure(search_bench.run("synthetic", designs, 2.0, "heuristic", 2000))
+    replayed = replay_figure(replay_bench.report("synthetic", designs))
+    group = built["groups"]["synthetic, simplified"]
+    assert group["designs"] == 3 and group["built"] + len(group["failed"]) == 3
+    s = searched["sets"]["synthetic"]
+    assert s["drawn"] == 3 and s["exact"] + len(s["not_exact"]) == s["searched"]
+    assert s["expansions"] >= s["searched"] and s["ms_per_expansion"]["max"] > 0
+    r = replayed["sets"]["synthetic"]
+    assert r["designs"] == 3 and r["steps"] >= 3 and r["ms_per_step"]["median"] <= r["ms_per_step"]["max"]
+    hook = _hook()
+    record = {"name": "n", "command": "c", "commit": "abc1234", "measured": "today"}
+    assert f"| synthetic, simplified | {group['built']}/3 (" in hook.build([{**record, "figure": built}])
+    assert "| synthetic (3 of 3 searched, heuristic, 2 s) |" in hook.search([{**record, "figure": searched}])
+    assert f"| synthetic (3) | {r['steps']} |" in hook.replay([{**record, "figure": replayed}])
