@@ -3,7 +3,7 @@
     python -m bench.corpus_bench [--per-folder 25] [--budget 20] [--seed 0] [--workers 2]
                                  [--guide heuristic|random|net] [--model PATH]
                                  [--index data/designs/index.parquet --split test]
-                                 [--fresh-from 0] [--against OLD/results.json]
+                                 [--fresh-from 0 ...] [--against OLD/results.json]
                                  [--corpus ../shared/data/fusion360_b123d] [--out bench_out/corpus]
 
 A seeded sample with the same number of designs from every timeline folder of the build123d corpus
@@ -14,12 +14,14 @@ zone graph, search, rebuild, B-rep IoU. Prints per folder: zone graphs built, ex
 IoU >= 0.9999), mean B-rep IoU, median time to exact, and every failure with its status; writes
 ``results.json`` and ``results.md`` under ``--out``. ``--index`` and ``--split`` keep only the designs
 of one split of a pipeline run (``data/designs/index.parquet``): a trained network is compared on
-designs it never saw. ``--fresh-from T`` draws only among the designs that the sample of seed ``T``
-did not draw: the tuning sample is seed 0 (every change of the core is measured on it), the
-validation sample is ``--seed 2023 --fresh-from 0``, a seed never used for tuning, so its figures
-come from parts that did not steer the work. A folder smaller than two samples (``08_21plus`` has
-15 designs) has no fresh designs left; the table shows it with 0 designs. ``--against`` names the
-``results.json`` of an earlier run of the same sample and lists every design exact there and not
+designs it never saw. ``--fresh-from T...`` draws only among the designs that the samples of
+seeds ``T...`` did not draw: the tuning sample is seed 0 (every change of the core is measured on
+it), the validation sample is ``--seed 2023 --fresh-from 0``, a seed never used for tuning, so its
+figures come from parts that did not steer the work. Failures are diagnosed on a third, disjoint
+sample (``--seed 5150 --fresh-from 0 2023``), so that looking into them steers neither. A folder
+smaller than two samples (``08_21plus`` has 15 designs) has no fresh designs left; the table shows
+it with 0 designs. ``--against`` names the ``results.json`` of an earlier run of the same sample
+and lists every design exact there and not
 now, and the reverse.
 """
 
@@ -28,6 +30,7 @@ from __future__ import annotations
 import argparse
 import json
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -46,13 +49,15 @@ def sample(
     per_folder: int,
     seed: int,
     keep: set[str] | None = None,
-    fresh_from: int | None = None,
+    fresh_from: Sequence[int] = (),
 ) -> list[CorpusEntry]:
     """``per_folder`` designs from every timeline folder, seeded (all of a smaller folder), drawn
-    from the designs in ``keep`` when given, and never one the sample of seed ``fresh_from`` drew."""
-    taken = (
-        set() if fresh_from is None else {e.design_id for e in sample(corpus, per_folder, fresh_from, keep)}
-    )
+    from the designs in ``keep`` when given, and never one that the samples of the seeds
+    ``fresh_from`` drew. Those samples form a chain: each seed is drawn fresh from the seeds before
+    it, so ``(0, 2023)`` leaves out the tuning sample and the validation sample drawn beside it."""
+    taken: set[str] = set()
+    for i, earlier in enumerate(fresh_from):
+        taken |= {e.design_id for e in sample(corpus, per_folder, earlier, keep, fresh_from[:i])}
     rng = np.random.default_rng(seed)
     entries = [
         e for e in list_corpus(corpus) if (keep is None or e.design_id in keep) and e.design_id not in taken
@@ -178,14 +183,18 @@ def main() -> None:
     parser.add_argument("--split", default="test", help="the split of --index to draw from")
     parser.add_argument("--against", type=Path, default=None, help="an earlier run's results.json")
     parser.add_argument(
-        "--fresh-from", type=int, default=None, help="leave out the designs the sample of this seed draws"
+        "--fresh-from",
+        type=int,
+        nargs="*",
+        default=(),
+        help="leave out the designs the samples of these seeds draw (each fresh from those before it)",
     )
     args = parser.parse_args()
     require_corpus(args.corpus)
     keep = split_ids(args.index, args.split) if args.index else None
     entries = sample(args.corpus, args.per_folder, args.seed, keep, args.fresh_from)
     config = InferConfig(guide=args.guide, budget_s=args.budget, model=args.model)
-    fresh = "" if args.fresh_from is None else f", none drawn by seed {args.fresh_from}"
+    fresh = f", none drawn by seeds {' '.join(map(str, args.fresh_from))}" if args.fresh_from else ""
     print(
         f"{len(entries)} designs (seed {args.seed}{fresh}), {args.guide}, budget {args.budget:g} s, "
         f"{args.workers} workers"

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import pytest
-from build123d import Box, Pos, Shape
+from build123d import Box, Face, Pos, Shape
+from OCP.BRep import BRep_Builder
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
+from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid
 
-from zonegraph.geometry.occ import fuzzy_boolean
+from zonegraph.geometry.occ import fuzzy_boolean, without_open_shells
 
 
 def _max_tolerance(shape: Shape) -> float:
@@ -25,3 +27,28 @@ def test_a_fuzzy_boolean_does_not_enlarge_its_operands_tolerances(operation):
     result = Shape.cast(fuzzy_boolean(operation(), a.wrapped, b.wrapped, 1e-4))
     assert result.volume > 0
     assert (_max_tolerance(a), _max_tolerance(b)) == before
+
+
+def _with_stray_face(solid: Shape) -> TopoDS_Solid:
+    """``solid`` with a square face inside it as a second, open shell: what a cut left on a
+    corpus part."""
+    shell = TopoDS_Shell()
+    builder = BRep_Builder()
+    builder.MakeShell(shell)
+    builder.Add(shell, (Pos(0, 0, 0.25) * Face.make_rect(0.5, 0.5)).wrapped)
+    out = TopoDS_Solid()
+    builder.MakeSolid(out)
+    for s in solid.shells():
+        builder.Add(out, s.wrapped)
+    builder.Add(out, shell)
+    return out
+
+
+def test_a_stray_open_shell_is_dropped_and_the_solid_keeps_its_volume():
+    box = Box(1, 1, 1)
+    stray = _with_stray_face(box)
+    assert Shape.cast(stray).volume != pytest.approx(1.0, abs=1e-6)  # the open shell counts
+    kept = without_open_shells(stray)
+    assert len(Shape.cast(kept).shells()) == 1 and Shape.cast(kept).is_valid
+    assert Shape.cast(kept).volume == pytest.approx(1.0, abs=1e-12)
+    assert without_open_shells(box.wrapped) is box.wrapped  # nothing to drop: the input itself

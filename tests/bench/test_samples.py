@@ -20,7 +20,7 @@ def tuning() -> dict[str, str]:
 
 @requires_corpus
 def test_the_validation_sample_is_disjoint_from_the_tuning_sample() -> None:
-    validation = sample(CORPUS, 25, VALIDATION_SEED, fresh_from=TUNING_SEED)
+    validation = sample(CORPUS, 25, VALIDATION_SEED, fresh_from=(TUNING_SEED,))
     assert len(tuning()) == 190 and 150 <= len(validation) <= 200
     assert not tuning().keys() & {e.design_id for e in validation}
 

@@ -17,7 +17,15 @@ from OCP.TopAbs import TopAbs_SOLID
 from OCP.TopoDS import TopoDS_Shape
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
-from zonegraph.geometry.occ import make_compound, shape_index, shape_list, shapes_of, sub_shapes
+from zonegraph.errors import is_kernel_error
+from zonegraph.geometry.occ import (
+    make_compound,
+    shape_index,
+    shape_list,
+    shapes_of,
+    sub_shapes,
+    without_open_shells,
+)
 
 
 def fuse_zones(zones: Sequence[TopoDS_Shape], selected: Sequence[int]) -> TopoDS_Shape:
@@ -67,8 +75,13 @@ def select_cells(
         avoid = [a for i, a in enumerate(arguments) if i not in owners]
         builder.AddToResult(shape_list(take), shape_list(avoid), 1, False)
     builder.RemoveInternalBoundaries()
-    raw = builder.Shape()
-    unified = _unified(BRepBuilderAPI_Copy(raw).Shape())
+    raw = without_open_shells(builder.Shape())
+    try:
+        unified = without_open_shells(_unified(BRepBuilderAPI_Copy(raw).Shape()))
+    except Exception as exc:  # "Courbes non jointives" on a corpus part whose raw cells were valid
+        if not is_kernel_error(exc):
+            raise
+        return raw
     return unified if _valid(unified) or not _valid(raw) else raw
 
 

@@ -22,10 +22,10 @@ from OCP.collections import (
 )
 from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
 from OCP.GProp import GProp_GProps
-from OCP.TopAbs import TopAbs_ShapeEnum
+from OCP.TopAbs import TopAbs_ShapeEnum, TopAbs_SHELL, TopAbs_SOLID
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
-from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Shape
+from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Iterator, TopoDS_Shape, TopoDS_Solid
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 
@@ -166,6 +166,39 @@ def make_compound(shapes: Iterable[TopoDS_Shape]) -> TopoDS_Compound:
     for s in shapes:
         builder.Add(comp, s)
     return comp
+
+
+def without_open_shells(shape: TopoDS_Shape) -> TopoDS_Shape:
+    """``shape``'s solids without the open shells some of them carry beside their closed ones.
+
+    A Boolean can leave a stray face inside a solid as a shell of its own (a cut of a corpus part
+    left a planar face as a second shell of one of its solids). The checker accepts
+    such a solid, but an open shell adds a volume that depends on the origin (here -2.6e-4 of the
+    part's), so a rebuild exact on zones measured IoU 0.99974. A solid whose shells are all closed,
+    or all open, is kept as it is; ``shape`` itself is returned when no solid changes."""
+    solids = sub_shapes(shape, TopAbs_SOLID)
+    kept = [_closed_shells_only(s) for s in solids]
+    if all(k is s for k, s in zip(kept, solids, strict=True)):
+        return shape
+    return kept[0] if len(kept) == 1 and shape.ShapeType() == TopAbs_SOLID else make_compound(kept)
+
+
+def _closed_shells_only(solid: TopoDS_Shape) -> TopoDS_Shape:
+    shells = []
+    it = TopoDS_Iterator(solid)
+    while it.More():
+        if it.Value().ShapeType() == TopAbs_SHELL:
+            shells.append(it.Value())
+        it.Next()
+    closed = [s for s in shells if BRep_Tool.IsClosed_s(s)]
+    if len(closed) in (0, len(shells)):
+        return solid
+    out = TopoDS_Solid()
+    builder = BRep_Builder()
+    builder.MakeSolid(out)
+    for shell in closed:
+        builder.Add(out, shell)
+    return out
 
 
 def face_triangles(face: TopoDS_Shape) -> tuple[np.ndarray, np.ndarray]:

@@ -8,6 +8,7 @@ and compared with the target by OpenCASCADE Booleans: that B-rep IoU is the hone
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -24,7 +25,13 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_SHAPE, TopAbs_SOLID
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.errors import is_kernel_error
 from zonegraph.geometry.cells import FUZZY_SHARES, cells_by_fuzzy
-from zonegraph.geometry.occ import ancestors, fuzzy_boolean, make_compound, precise_volume
+from zonegraph.geometry.occ import (
+    ancestors,
+    fuzzy_boolean,
+    make_compound,
+    precise_volume,
+    without_open_shells,
+)
 from zonegraph.geometry.shapes import volume_of
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
@@ -282,7 +289,21 @@ def _boolean(shape: Shape, tool: Shape, op: Op, fuzzy: float) -> Shape | None:
     if out.IsNull():
         return None
     result = Shape.cast(out)
-    return result.clean() if result.volume > 0 else None
+    return _cleaned(result) if result.volume > 0 else None
+
+
+def _cleaned(shape: Shape) -> Shape:
+    """``shape`` with its same-domain faces merged, as build123d's ``clean`` does, unless the
+    merge breaks a valid shape: seen on a corpus part whose valid union of two prisms came back
+    invalid from it, so every alternative and the cells failed with it and a program exact on
+    zones was reported ``rebuild_failed``. The merged faces are cosmetic. ``clean`` works in
+    place, hence the copy. Stray open shells are dropped
+    (:func:`~zonegraph.geometry.occ.without_open_shells`)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "Unable to clean": the raw shape is kept, as below
+        cleaned = Shape.cast(shape.wrapped).clean()
+    chosen = cleaned if cleaned.is_valid or not shape.is_valid else shape
+    return Shape.cast(without_open_shells(chosen.wrapped))
 
 
 def _repaired(shape: Shape) -> Shape:
