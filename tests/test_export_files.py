@@ -23,7 +23,7 @@ from zonegraph.data.replay import cells_bodies
 from zonegraph.reconstruction import EXACT_IOU, infer
 from zonegraph.testing import CORPUS, requires_corpus
 
-WRITTEN_LOOP_DESIGNS = [
+EXACT_FILE_DESIGNS = [
     ("01_2ops/batch_012.py", "41737_b6724677_0000"),
     ("02_3ops/batch_003.py", "24650_dad8c8ee_0000"),
     pytest.param(
@@ -35,12 +35,20 @@ WRITTEN_LOOP_DESIGNS = [
         # says so when it passes again).
         marks=pytest.mark.xfail(strict=True, reason="script of the 20-step program rebuilds to 0.99974"),
     ),
+    # a 94 cm spline side: the script's 24-point interpolation strayed 3e-4 of it (IoU 0.99988)
+    ("02_3ops/batch_007.py", "87564_c58c72e9_0002"),
+    # a merged sketch face with a 2e-5 cm stray of a neighbouring circle: the JSON's profile area
+    # was the face's, which the written arcs differ from by 1.8e-4, and the reader refused it
+    ("05_8to10ops/batch_009.py", "54285_76f37095_0003"),
+    # pins joined into the round holes they fill: invalid at every fuzzy value in both files
+    # (script 0.0046, JSON refused) until the shape fixer mends the join
+    ("06_11to15ops/batch_002.py", "22305_5b45cdb3_0002"),
 ]
 
 
 @requires_corpus
-@pytest.mark.parametrize(("batch", "design_id"), WRITTEN_LOOP_DESIGNS)
-def test_partition_faces_are_written_as_closed_planar_loops(
+@pytest.mark.parametrize(("batch", "design_id"), EXACT_FILE_DESIGNS)
+def test_the_files_of_a_zone_exact_program_rebuild_the_part(
     batch: str, design_id: str, tmp_path: Path
 ) -> None:
     from zonegraph.data.b123d import convert_design

@@ -216,11 +216,15 @@ def replay_extrude(
 def retried_operation(bodies: tuple[Solid, ...], tool: Shape, op: Operation) -> tuple[Solid, ...] | None:
     """A join or cut that gave an invalid solid, again with the bodies as the arguments and the
     tool as the tool, exact and then at the fuzzy values of ``FUZZY_SHARES``; the first
-    valid result, else None. The order matters to OpenCASCADE: a join of a written program
-    whose tool-first fuse was invalid came back valid with the body first."""
+    valid result, else the first result repaired by OpenCASCADE's shape fixer where that is valid
+    with a volume the operation allows, else None. The order matters to OpenCASCADE: a join of a
+    written program whose tool-first fuse was invalid came back valid with the body first. A join
+    of two pins into the round holes they fill came back invalid in every order and at every
+    fuzzy value, and valid, with the volume of both, once fixed."""
     if op not in (Operation.JOIN, Operation.CUT):
         return None
     diag = float(Compound([*bodies, tool]).bounding_box().diagonal)
+    first: tuple[Solid, ...] = ()
     for share in FUZZY_SHARES:
         try:
             after = _body_first(bodies, tool, op, share * diag)
@@ -228,7 +232,24 @@ def retried_operation(bodies: tuple[Solid, ...], tool: Shape, op: Operation) -> 
             continue
         if after and all(b.is_valid for b in after):
             return after
+        first = first or after
+    fixed = tuple(b.fix() for b in first)
+    if fixed and all(b.is_valid for b in fixed) and _possible_volume(bodies, tool, op, fixed):
+        return fixed
     return None
+
+
+POSSIBLE_RTOL = 1e-5  # volume integration slack of a repaired result's bounds
+
+
+def _possible_volume(bodies: tuple[Solid, ...], tool: Shape, op: Operation, after: tuple[Solid, ...]) -> bool:
+    """Whether ``after`` holds a volume that ``op`` of ``tool`` on ``bodies`` can give: a join at
+    least the larger and at most both, a cut at most the bodies and at least the bodies less the
+    tool. The shape fixer can make a result valid by dropping what it cannot mend."""
+    before, cutter, out = sum(b.volume for b in bodies), tool.volume, sum(b.volume for b in after)
+    slack = POSSIBLE_RTOL * (before + cutter)
+    low, high = (max(before, cutter), before + cutter) if op is Operation.JOIN else (before - cutter, before)
+    return low - slack <= out <= high + slack
 
 
 def _body_first(bodies: tuple[Solid, ...], tool: Shape, op: Operation, fuzzy: float) -> tuple[Solid, ...]:
