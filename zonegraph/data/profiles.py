@@ -147,6 +147,17 @@ def loop_face(loop: Loop, frame: Frame, snap: _Snapper, where: str) -> Face:
     return face
 
 
+def face_profile_area(profile: Profile, frame: Frame, where: str) -> float:
+    """The area :func:`profile_faces` builds for the profile of one face (one outer loop, its
+    holes inside it and apart), measured loop by loop: the outer loop's face less its holes'.
+    ``profile_faces`` cuts the holes out one Boolean at a time, which took minutes on a sketch
+    face of a corpus part with hundreds of holes."""
+    snap = _Snapper()
+    return sum(
+        (1.0 if lp.is_outer else -1.0) * loop_face(lp, frame, snap, where).area for lp in profile.loops
+    )
+
+
 def profile_faces(profile: Profile, frame: Frame, where: str) -> list[Face]:
     """The profile region: union of outer loops minus inner loops, checked against Fusion's area."""
     snap = _Snapper()

@@ -18,6 +18,11 @@ from pathlib import Path
 
 import numpy as np
 from build123d import Edge, Face, GeomType, Shape, Unit, Vector
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.GCPnts import GCPnts_AbscissaPoint, GCPnts_UniformAbscissa
+from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
+from OCP.gp import gp_Pnt
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.data.design import (
@@ -38,7 +43,7 @@ from zonegraph.data.design import (
     Sketch,
     design_to_json,
 )
-from zonegraph.data.profiles import profile_faces
+from zonegraph.data.profiles import face_profile_area
 from zonegraph.errors import DesignError
 from zonegraph.export.idioms import named_plane, plane_code, plane_of_frame, plane_phrase, sketch_object
 from zonegraph.export.loops import LoopEdge, loop_edges
@@ -57,8 +62,10 @@ SPLINE_TOL = 1e-7
 SPLINE_SAMPLES = 24  # the fewest points the script's interpolating spline runs through
 # The script's spline doubles its points until it stays this close to the curve, relative to the
 # curve's length: 24 points of a 94 cm spline of the corpus strayed 3e-4 of it, so the written
-# script rebuilt its part to IoU 0.99988 (192 points: 1.6e-7).
-SPLINE_FIT = 1e-6
+# script rebuilt its part to IoU 0.99988 (96 points: 3.6e-6 and 0.999998). Not tighter: every
+# point is a knot, and the exact volume integration of the written part slows with each (48-point
+# splines instead of 24 made a partial program's IoU take 275 s instead of about 50).
+SPLINE_FIT = 1e-5
 SPLINE_MAX_SAMPLES = 384
 
 
@@ -197,24 +204,47 @@ def local_edge(piece: LoopEdge, frame: Frame, snap: Snapper | None = None) -> Lo
         return _arc(piece, frame, snap)
     begin = np.array(tuple(edge.position_at(0)))
     first, last = (snap.point(_local(frame, q)) for q in _from_nearest(begin, piece.start, piece.end))
-    inside = [
-        snap.point(_local(frame, edge.position_at(t))) for t in np.linspace(0, 1, spline_samples(edge))[1:-1]
-    ]
+    inside = [snap.point(_local(frame, q)) for q in spline_points(edge)[1:-1]]
     return LocalEdge("spline", np.array([first, *inside, last]), _nurbs(piece, frame, snap))
 
 
-def spline_samples(edge: Edge) -> int:
-    """How many evenly spaced points an interpolating spline needs to follow ``edge`` within
-    ``SPLINE_FIT`` of its length, checked half-way between the points (at most
-    ``SPLINE_MAX_SAMPLES``)."""
+def spline_points(edge: Edge) -> list[np.ndarray]:
+    """Points evenly spaced along ``edge`` by arc length, from its start (``position_at(0)``), that
+    an interpolating spline through them follows within ``SPLINE_FIT`` of the edge's length,
+    checked half-way between them: ``SPLINE_SAMPLES`` doubled until it does (at most
+    ``SPLINE_MAX_SAMPLES``). One pass of OpenCASCADE's uniform abscissa per try: build123d's
+    ``position_at`` measures the whole curve at every call, which made the check minutes long on
+    a corpus part with many free-form sketch edges."""
+    curve = edge.geom_adaptor()
+    tol = SPLINE_FIT * GCPnts_AbscissaPoint.Length_s(curve)
     n = SPLINE_SAMPLES
-    while n < SPLINE_MAX_SAMPLES:
-        fitted = Edge.make_spline([edge.position_at(t) for t in np.linspace(0, 1, n)])
-        halfway = (np.arange(n - 1) + 0.5) / (n - 1)
-        if max(fitted.distance_to(edge.position_at(t)) for t in halfway) <= SPLINE_FIT * edge.length:
-            return n
+    while True:
+        points = _even_points(curve, 2 * n - 1, edge.is_forward)
+        samples, halfway = points[::2], points[1::2]
+        if n >= SPLINE_MAX_SAMPLES or _strays(samples, halfway) <= tol:
+            return samples
         n *= 2
-    return n
+
+
+def _even_points(curve: BRepAdaptor_Curve, count: int, forward: bool) -> list[np.ndarray]:
+    abscissa = GCPnts_UniformAbscissa(curve, count)
+    if not abscissa.IsDone():
+        raise ValueError("OpenCASCADE could not space points along a sketch edge")
+    params = [abscissa.Parameter(i) for i in range(1, abscissa.NbPoints() + 1)]
+    points = [np.array(curve.Value(u).Coord()) for u in params]
+    return points if forward else points[::-1]
+
+
+def _strays(samples: list[np.ndarray], halfway: list[np.ndarray]) -> float:
+    """How far the spline interpolating ``samples`` passes from ``halfway`` at most."""
+    fitted = Edge.make_spline([Vector(*q) for q in samples])
+    spline = BRep_Tool.Curve_s(fitted.wrapped, 0.0, 1.0)
+    project = GeomAPI_ProjectPointOnCurve()
+    far = 0.0
+    for q in halfway:
+        project.Init(gp_Pnt(*q), spline)
+        far = max(far, project.LowerDistance() if project.NbPoints() else math.inf)
+    return far
 
 
 def _from_nearest(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -508,10 +538,11 @@ def written_profile(pid: str, loops: FaceLoops, frame: Frame, face_area: float) 
     more than the reader allows: on a corpus part a merged face kept a 2e-5 cm stray of a
     neighbouring circle, which the written arc (the loop's corners, the designer's radius) does
     not, so the file was refused although it rebuilt the part. ``face_area`` stands in where the
-    written loops do not build, so the replay reports that instead."""
+    written loops do not build, so the replay reports that instead. A sketch face is one outer
+    loop with its holes (:func:`~zonegraph.data.profiles.face_profile_area`)."""
     profile = Profile(pid, tuple(Loop(outer, tuple(e.curve for e in edges)) for outer, edges in loops), None)
     try:
-        area = sum(f.area for f in profile_faces(profile, frame, pid))
+        area = face_profile_area(profile, frame, pid)
     except DesignError:
         area = face_area
     return replace(profile, area=area)
