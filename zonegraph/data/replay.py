@@ -25,6 +25,7 @@ from zonegraph.data.profiles import profile_faces
 from zonegraph.errors import DesignError, ReplayError, is_kernel_error
 from zonegraph.geometry.cells import FUZZY_SHARES, cells_by_fuzzy
 from zonegraph.geometry.occ import fuzzy_boolean, make_compound
+from zonegraph.geometry.shapes import possible_volume
 from zonegraph.verified import REPLAY_RTOL, Measured, disagreement, relative_difference
 
 TOUCH_TOL = 1e-6  # cm: a join tool this close to a body merges with it
@@ -234,22 +235,10 @@ def retried_operation(bodies: tuple[Solid, ...], tool: Shape, op: Operation) -> 
             return after
         first = first or after
     fixed = tuple(b.fix() for b in first)
-    if fixed and all(b.is_valid for b in fixed) and _possible_volume(bodies, tool, op, fixed):
-        return fixed
-    return None
-
-
-POSSIBLE_RTOL = 1e-5  # volume integration slack of a repaired result's bounds
-
-
-def _possible_volume(bodies: tuple[Solid, ...], tool: Shape, op: Operation, after: tuple[Solid, ...]) -> bool:
-    """Whether ``after`` holds a volume that ``op`` of ``tool`` on ``bodies`` can give: a join at
-    least the larger and at most both, a cut at most the bodies and at least the bodies less the
-    tool. The shape fixer can make a result valid by dropping what it cannot mend."""
-    before, cutter, out = sum(b.volume for b in bodies), tool.volume, sum(b.volume for b in after)
-    slack = POSSIBLE_RTOL * (before + cutter)
-    low, high = (max(before, cutter), before + cutter) if op is Operation.JOIN else (before - cutter, before)
-    return low - slack <= out <= high + slack
+    if not fixed or not all(b.is_valid for b in fixed):
+        return None
+    before, held = (sum(b.volume for b in group) for group in (bodies, fixed))
+    return fixed if possible_volume(op is Operation.JOIN, before, tool.volume, held) else None
 
 
 def _body_first(bodies: tuple[Solid, ...], tool: Shape, op: Operation, fuzzy: float) -> tuple[Solid, ...]:

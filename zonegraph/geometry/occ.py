@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from typing import TypeVar
 
 import numpy as np
 from OCP.Bnd import Bnd_Box
@@ -28,6 +29,8 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Iterator, TopoDS_Shape, TopoDS_Solid
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
+
+_Container = TypeVar("_Container", TopoDS_Compound, TopoDS_Solid)
 
 
 def pnt(p: Sequence[float] | np.ndarray) -> gp_Pnt:
@@ -161,11 +164,16 @@ def bounds(shape: TopoDS_Shape, optimal: bool = True) -> np.ndarray:
 
 def make_compound(shapes: Iterable[TopoDS_Shape]) -> TopoDS_Compound:
     comp = TopoDS_Compound()
+    BRep_Builder().MakeCompound(comp)
+    return _filled(comp, shapes)
+
+
+def _filled(container: _Container, parts: Iterable[TopoDS_Shape]) -> _Container:
+    """``container`` (made empty by a builder) with ``parts`` added to it."""
     builder = BRep_Builder()
-    builder.MakeCompound(comp)
-    for s in shapes:
-        builder.Add(comp, s)
-    return comp
+    for part in parts:
+        builder.Add(container, part)
+    return container
 
 
 def without_open_shells(shape: TopoDS_Shape) -> TopoDS_Shape:
@@ -194,11 +202,8 @@ def _closed_shells_only(solid: TopoDS_Shape) -> TopoDS_Shape:
     if len(closed) in (0, len(shells)):
         return solid
     out = TopoDS_Solid()
-    builder = BRep_Builder()
-    builder.MakeSolid(out)
-    for shell in closed:
-        builder.Add(out, shell)
-    return out
+    BRep_Builder().MakeSolid(out)
+    return _filled(out, closed)
 
 
 def face_triangles(face: TopoDS_Shape) -> tuple[np.ndarray, np.ndarray]:

@@ -123,6 +123,21 @@ def symmetric_difference_volume(a: Shape, b: Shape) -> float:
     return volume_of(a.cut(b)) + volume_of(b.cut(a))
 
 
+# Relative slack of :func:`possible_volume`'s bounds, for volume integration error: a failed
+# Boolean that the checker accepts loses far more (a valid union of a corpus part that held 1%).
+POSSIBLE_RTOL = 1e-5
+
+
+def possible_volume(union: bool, part: float, tool: float, result: float) -> bool:
+    """Whether ``result`` is a volume that ``part`` fused with (``union``) or cut by ``tool`` can
+    have: a union holds at least the larger operand and at most both, a cut at most the part and
+    at least the part less the tool. The checker accepts some Boolean results that lose most of
+    the part, and the shape fixer can make one valid by dropping what it cannot mend."""
+    slack = POSSIBLE_RTOL * (part + tool)
+    low, high = (max(part, tool), part + tool) if union else (part - tool, part)
+    return low - slack <= result <= high + slack
+
+
 def volume_of(shape: Shape | list[Shape] | None) -> float:
     """Volume of a Boolean result: a shape, a list of shapes (build123d's intersect) or None,
     integrated to 1e-9 (:func:`~zonegraph.geometry.occ.precise_volume`)."""

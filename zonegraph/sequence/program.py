@@ -32,7 +32,7 @@ from zonegraph.geometry.occ import (
     precise_volume,
     without_open_shells,
 )
-from zonegraph.geometry.shapes import volume_of
+from zonegraph.geometry.shapes import possible_volume, volume_of
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
@@ -224,20 +224,8 @@ def _combine(shape: Shape, tool: Shape, op: Op) -> tuple[Shape | None, bool]:
     return first, False
 
 
-# Relative slack of :func:`_possible`'s volume bounds, for volume integration error: a failed
-# Boolean that the checker accepts loses far more (a valid union of a corpus part that held 1%).
-POSSIBLE_RTOL = 1e-5
-
-
 def _possible(shape: Shape, tool: Shape, op: Op, result: Shape) -> bool:
-    """Whether ``result``'s volume is one ``shape`` (op) ``tool`` can have: a union holds at least
-    the larger operand and at most both, a cut at most the part and at least the part less the
-    tool. The checker accepts some results that lose most of the part."""
-    part, cutter, out = shape.volume, tool.volume, result.volume
-    slack = POSSIBLE_RTOL * (part + cutter)
-    if op is Op.UNION:
-        return max(part, cutter) - slack <= out <= part + cutter + slack
-    return part - cutter - slack <= out <= part + slack
+    return possible_volume(op is Op.UNION, shape.volume, tool.volume, result.volume)
 
 
 def _cells_rebuild(ops: list[Op], tools: list[Shape], diag: float) -> Shape | None:
