@@ -9,7 +9,7 @@ from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut, BRepAlgoAPI_Fus
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid
 
-from zonegraph.geometry.occ import fuzzy_boolean, without_open_shells
+from zonegraph.geometry.occ import fuzzy_boolean, overlaps_merged, precise_volume, without_open_shells
 
 
 def _max_tolerance(shape: Shape) -> float:
@@ -52,3 +52,14 @@ def test_a_stray_open_shell_is_dropped_and_the_solid_keeps_its_volume():
     assert len(Shape.cast(kept).shells()) == 1 and Shape.cast(kept).is_valid
     assert Shape.cast(kept).volume == pytest.approx(1.0, abs=1e-12)
     assert without_open_shells(box.wrapped) is box.wrapped  # nothing to drop: the input itself
+
+
+def test_overlapping_solids_are_merged_and_touching_or_apart_ones_kept():
+    """Two unit boxes overlapping by a quarter become one region of 1.75; a box that only
+    touches them and one far away stay as they are."""
+    a, b = Box(1, 1, 1), Pos(0.5, 0.5, 0) * Box(1, 1, 1)
+    touching, apart = Pos(0, 0, 1) * Box(1, 1, 1), Pos(5, 0, 0) * Box(1, 1, 1)
+    merged = overlaps_merged([s.wrapped for s in (a, touching, b, apart)])
+    volumes = sorted(precise_volume(s) for s in merged)
+    assert volumes == pytest.approx([1, 1, 1.75])
+    assert merged[1] is touching.wrapped and merged[2] is apart.wrapped

@@ -26,8 +26,7 @@ from build123d import Part, Shape, Solid, Unit
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.configs import InferConfig
-from zonegraph.data.replay import as_shape
-from zonegraph.data.targets import load_target
+from zonegraph.data.targets import load_target, target_region
 from zonegraph.export.verify import Export, run_script, verified_export
 from zonegraph.export.writers import write_outputs
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
@@ -333,7 +332,7 @@ def infer(
     """
     path, out_dir = Path(target_path), Path(out)
     rec = reconstruct(path, config, saved_graph)
-    target = as_shape(rec.solids)
+    target = target_region(rec.solids)
     program: list[ProgramStep] = []
     states: list = []
     rebuild_error, iou = "", 0.0

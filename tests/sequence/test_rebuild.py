@@ -43,6 +43,8 @@ WORK = InferConfig(budget_s=math.inf, max_expansions=2000)  # the same search on
         ("07_16to20ops/batch_003.py", "73416_5b3ea504_0000"),
         # the valid union of two invalid prisms, broken by merging its same-domain faces
         ("04_6to7ops/batch_010.py", "64675_42df5e14_0000"),
+        # two bodies that overlap: measured against the region they fill, not their volumes summed
+        ("05_8to10ops/batch_006.py", "38926_1eaf0b52_0000"),
     ],
 )
 def test_a_zone_exact_program_rebuilds_exactly(batch, design_id, tmp_path):

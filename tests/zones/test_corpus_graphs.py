@@ -43,3 +43,30 @@ def test_zones_the_solid_classifier_mislabels_at_an_extruded_wall_are_labelled_o
     assert graph.zone_volume.sum() / graph.box_volume == pytest.approx(1, abs=BOX_VOLUME_RTOL)
     assert graph.inside_volume / graph.target_volume == pytest.approx(1, abs=TARGET_VOLUME_RTOL)
     assert graph.n_zones == 3 and int(graph.zone_inside.sum()) == 1
+
+
+def test_overlapping_bodies_are_measured_as_the_region_they_fill():
+    """Two bodies that overlap by 0.55 cm^3: their volumes summed count it twice, so the zones
+    (which can only hold the region) were refused at 0.999775 of the sum."""
+    shape = corpus_shape("05_8to10ops/batch_006.py", "38926_1eaf0b52_0000")
+    summed = sum(s.volume for s in shape.solids())
+    graph = build_zone_graph(shape, samples=0)
+    assert graph.target_volume / graph.normalization.scale**3 < (1 - 1e-4) * summed
+    assert graph.inside_volume / graph.target_volume == pytest.approx(1, abs=TARGET_VOLUME_RTOL)
+
+
+@pytest.mark.parametrize(
+    ("batch", "design_id"),
+    [
+        ("02_3ops/batch_007.py", "83562_851e465d_0000"),  # inside zones held 0.999817
+        ("07_16to20ops/batch_002.py", "25199_d7aff7a5_0023"),  # zones summed to 0.999907 of the box
+    ],
+)
+def test_the_part_s_own_curved_faces_pin_splits_the_general_fuse_dropped(batch, design_id):
+    """Every plain general fuse of these parts leaves a zone that straddles the target (a region
+    between two full cylinders that meet the part at a cusp stays unsplit); with the target's
+    curved faces beside their cylinders the graph holds the target and tiles the box."""
+    graph = build_zone_graph(corpus_shape(batch, design_id), samples=0)
+    assert graph.info["partition"] == "anchored"
+    assert graph.inside_volume / graph.target_volume == pytest.approx(1, abs=TARGET_VOLUME_RTOL)
+    assert graph.zone_volume.sum() / graph.box_volume == pytest.approx(1, abs=BOX_VOLUME_RTOL)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from zonegraph.geometry.shapes import read_kernel_solids
 
 if TYPE_CHECKING:
-    from build123d import Solid
+    from build123d import Shape, Solid
     from OCP.TopoDS import TopoDS_Shape
 
 
@@ -39,3 +39,18 @@ def load_kernel_target(path: str | Path) -> list[TopoDS_Shape]:
     if path.suffix.lower() == ".json":
         return [s.wrapped for s in _replayed(path)]
     return read_kernel_solids(path)
+
+
+def target_region(solids: list[Solid]) -> Shape:
+    """The region a target's solids fill, as one shape: overlapping bodies fused
+    (:func:`~zonegraph.geometry.occ.overlaps_merged`), so that a program that rebuilds the region
+    measures IoU 1 against it, not against the bodies' volumes summed."""
+    from build123d import Shape
+
+    from zonegraph.data.replay import as_shape
+    from zonegraph.geometry.occ import overlaps_merged
+
+    merged = overlaps_merged([s.wrapped for s in solids])
+    if len(merged) == len(solids):
+        return as_shape(solids)
+    return as_shape([Shape.cast(s) for s in merged])

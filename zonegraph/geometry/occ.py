@@ -8,7 +8,7 @@ from typing import TypeVar
 import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Builder, BRep_Tool
-from OCP.BRepAlgoAPI import BRepAlgoAPI_BooleanOperation
+from OCP.BRepAlgoAPI import BRepAlgoAPI_BooleanOperation, BRepAlgoAPI_Common, BRepAlgoAPI_Fuse
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.BRepGProp import BRepGProp
@@ -189,6 +189,58 @@ def without_open_shells(shape: TopoDS_Shape) -> TopoDS_Shape:
     if all(k is s for k, s in zip(kept, solids, strict=True)):
         return shape
     return kept[0] if len(kept) == 1 and shape.ShapeType() == TopAbs_SOLID else make_compound(kept)
+
+
+# Share of the smaller solid's volume two solids must hold in common to count as overlapping:
+# above volume integration noise, far below a real overlap (a corpus part's two bodies: 2.2e-4 of
+# the part, 0.47 of the smaller body).
+OVERLAP_RTOL = 1e-9
+
+
+def overlaps_merged(solids: Sequence[TopoDS_Shape]) -> list[TopoDS_Shape]:
+    """``solids`` with every group of overlapping ones replaced by their union.
+
+    A design's bodies may overlap (a new body drawn into an earlier one): its shape is the region
+    they fill, which is what zones can represent and what a program rebuilds, while the bodies'
+    volumes summed count the overlap twice (a corpus part's zones held 0.999775 of that sum and
+    the graph was refused). Disjoint and merely touching solids are returned as they are."""
+    owner = list(range(len(solids)))  # union-find over the solids
+
+    def root(i: int) -> int:
+        while owner[i] != i:
+            i = owner[i]
+        return i
+
+    for i in range(len(solids)):
+        for j in range(i + 1, len(solids)):
+            if root(i) != root(j) and _overlap(solids[i], solids[j]):
+                owner[root(j)] = root(i)
+    groups: dict[int, list[TopoDS_Shape]] = {}
+    for i, s in enumerate(solids):
+        groups.setdefault(root(i), []).append(s)
+    return [g[0] if len(g) == 1 else _union(g) for g in groups.values()]
+
+
+def _overlap(a: TopoDS_Shape, b: TopoDS_Shape) -> bool:
+    ba, bb = bounds(a, optimal=False), bounds(b, optimal=False)
+    if np.any(ba[:3] > bb[3:]) or np.any(bb[:3] > ba[3:]):
+        return False
+    try:
+        common = precise_volume(fuzzy_boolean(BRepAlgoAPI_Common(), a, b, 0.0))
+    except ValueError:
+        return False
+    return common > OVERLAP_RTOL * min(precise_volume(a), precise_volume(b))
+
+
+def _union(solids: list[TopoDS_Shape]) -> TopoDS_Shape:
+    """One fused solid of ``solids`` (where the fuse fails they are kept side by side)."""
+    shape = solids[0]
+    for other in solids[1:]:
+        try:
+            shape = fuzzy_boolean(BRepAlgoAPI_Fuse(), shape, other, 0.0)
+        except ValueError:
+            return make_compound(solids)
+    return shape
 
 
 def _closed_shells_only(solid: TopoDS_Shape) -> TopoDS_Shape:

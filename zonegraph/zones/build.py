@@ -36,6 +36,7 @@ from zonegraph.geometry.occ import (
     bounds,
     face_triangles,
     make_compound,
+    overlaps_merged,
     pnt,
     shape_index,
     shape_list,
@@ -126,16 +127,23 @@ class _Unsplit:
         return ShapeList()
 
 
+def _tools(surfaces: list[ExtendedSurface], anchored: bool) -> list[tuple[int, TopoDS_Shape]]:
+    """(surface index, shape) of every partition tool: the sheets, and with ``anchored`` the
+    target's faces on curved surfaces (``ExtendedSurface.anchors``)."""
+    return [
+        (i, tool) for i, s in enumerate(surfaces) for tool in (s.sheets + s.anchors if anchored else s.sheets)
+    ]
+
+
 def _fuse(
-    box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface], fuzzy: float, source: str
+    box_solid: TopoDS_Shape, tools: list[tuple[int, TopoDS_Shape]], fuzzy: float, source: str
 ) -> BOPAlgo_Builder | _Unsplit:
-    if not any(s.sheets for s in surfaces):
+    if not tools:
         return _Unsplit(box_solid)
     builder = BOPAlgo_Builder()
     builder.AddArgument(box_solid)
-    for s in surfaces:
-        for sheet in s.sheets:
-            builder.AddArgument(sheet)
+    for _, tool in tools:
+        builder.AddArgument(tool)
     return _perform(builder, fuzzy, source, "general fuse")
 
 
@@ -182,10 +190,10 @@ def _within(inner: np.ndarray, outer: np.ndarray, tol: float) -> bool:
 
 
 def _make_volumes(
-    box_solid: TopoDS_Shape, box: np.ndarray, surfaces: list[ExtendedSurface], fuzzy: float, source: str
+    box_solid: TopoDS_Shape, box: np.ndarray, tools: list[tuple[int, TopoDS_Shape]], fuzzy: float, source: str
 ) -> _VolumeMaker:
     maker = BOPAlgo_MakerVolume()
-    maker.SetArguments(shape_list([box_solid] + [sheet for s in surfaces for sheet in s.sheets]))
+    maker.SetArguments(shape_list([box_solid] + [tool for _, tool in tools]))
     maker.SetIntersect(True)
     _perform(maker, fuzzy, source, "volume maker")
     return _VolumeMaker(maker, box)
@@ -195,9 +203,14 @@ Partitioner: TypeAlias = "BOPAlgo_Builder | _Unsplit | _VolumeMaker"
 
 
 def _ladder(fuzzy: Sequence[float] | float) -> list[tuple[str, float]]:
-    """(method, fuzzy value) pairs tried in turn: the general fuse first, then the volume maker."""
+    """(method, fuzzy value) pairs tried in turn: the general fuse, then the general fuse with the
+    target's curved faces beside their sheets (``anchored``), then the volume maker."""
     values = [fuzzy] if isinstance(fuzzy, float) else list(fuzzy)
-    return [("fuse", v) for v in values] + [("volumes", v) for v in VOLUME_MAKER_LADDER]
+    return (
+        [("fuse", v) for v in values]
+        + [("anchored", values[0])]
+        + [("volumes", v) for v in VOLUME_MAKER_LADDER]
+    )
 
 
 def build_zone_graph(
@@ -243,7 +256,10 @@ def build_zone_graph(
     norm = Normalization.of(shape)
     target_n = norm.apply(shape)
     solids = sub_shapes(target_n, TopAbs_SOLID)
-    target_volume = sum(volume_props(s)[0] for s in solids)
+    # The region the solids fill: overlapping bodies' volumes summed count the overlap twice.
+    # Their faces and classifiers stay the bodies' own (a fused pair classified zones outside it
+    # as inside on a corpus part).
+    target_volume = sum(volume_props(s)[0] for s in overlaps_merged(solids))
     if not target_volume > 0:
         raise ZoneGraphBuildError(Status.INVALID_INPUT, source, "target has no volume")
     box = bounds(target_n)
@@ -333,13 +349,14 @@ def _partition(
 ) -> ZoneGraph:
     box_solid = BRepPrimAPI_MakeBox(pnt(box[:3]), pnt(box[3:])).Solid()
     kind, fuzzy = method
+    tools = _tools(surfaces, anchored=kind == "anchored")
     builder: Partitioner = (
-        _fuse(box_solid, surfaces, fuzzy, source)
-        if kind == "fuse"
-        else _make_volumes(box_solid, box, surfaces, fuzzy, source)
+        _make_volumes(box_solid, box, tools, fuzzy, source)
+        if kind == "volumes"
+        else _fuse(box_solid, tools, fuzzy, source)
     )
     timer.lap("fuse_s")
-    topo = _Topology(builder, box_solid, surfaces)
+    topo = _Topology(builder, box_solid, surfaces, tools)
     timer.lap("topology_s")
     mesh = _ZoneMesh(topo)
     interior, inside = _interior_and_inside(mesh, solids, topo.zone_volume, target_volume)
@@ -439,7 +456,13 @@ def _solid_mesh_volume(solid: TopoDS_Shape) -> float:
 class _Topology:
     """Zones, partition faces and which surface each face lies on, from the fuse result."""
 
-    def __init__(self, builder: Partitioner, box_solid: TopoDS_Shape, surfaces: list[ExtendedSurface]):
+    def __init__(
+        self,
+        builder: Partitioner,
+        box_solid: TopoDS_Shape,
+        surfaces: list[ExtendedSurface],
+        tools: list[tuple[int, TopoDS_Shape]],
+    ):
         result = builder.Shape()
         zone_index = shape_index(result, TopAbs_SOLID)
         self.zones = [TopoDS.Solid(zone_index.FindKey(i)) for i in range(1, zone_index.Size() + 1)]
@@ -455,7 +478,7 @@ class _Topology:
         self.face_area = np.array([p[0] for p in fprops])
         self.face_centroid = np.array([p[1] for p in fprops]).reshape(-1, 3)
         self.surfaces = surfaces
-        self.face_surface = self._face_surfaces(builder, box_solid)
+        self.face_surface = self._face_surfaces(builder, box_solid, tools)
 
     def _face_zones(self) -> np.ndarray:
         out = np.full((len(self.faces), 2), -1, np.int32)
@@ -466,14 +489,15 @@ class _Topology:
             out[i, : len(owners[:2])] = owners[:2]
         return out
 
-    def _face_surfaces(self, builder: Partitioner, box_solid: TopoDS_Shape) -> np.ndarray:
+    def _face_surfaces(
+        self, builder: Partitioner, box_solid: TopoDS_Shape, tools: list[tuple[int, TopoDS_Shape]]
+    ) -> np.ndarray:
         out = np.full(len(self.faces), -1, np.int32)
-        for s_idx, s in enumerate(self.surfaces):
-            for sheet in s.sheets:
-                for piece in _images(builder, sheet):
-                    k = self.face_map.FindIndex(piece)
-                    if k > 0:
-                        out[k - 1] = s_idx
+        for s_idx, tool in tools:
+            for piece in _images(builder, tool):
+                k = self.face_map.FindIndex(piece)
+                if k > 0:
+                    out[k - 1] = s_idx
         for face in sub_shapes(box_solid, TopAbs_FACE):
             s_idx = self._match_plane(BRepAdaptor_Surface(TopoDS.Face(face)))
             for piece in _images(builder, face):

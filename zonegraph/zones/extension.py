@@ -44,6 +44,9 @@ class SurfaceKind(str, enum.Enum):
     FACE = "face"
 
 
+CURVED = (SurfaceKind.CYLINDER, SurfaceKind.SPHERE, SurfaceKind.EXTRUSION)  # surfaces with anchors
+
+
 @dataclass
 class ExtendedSurface:
     """One distinct surface of the target, and the sheets that represent it in the fuse."""
@@ -58,6 +61,10 @@ class ExtendedSurface:
     on_box: bool = False  # one of the six box faces
     strips: list[tuple[np.ndarray, float, float]] = field(default_factory=list)  # (direction, e0, e1)
     sheets: list[TopoDS_Shape] = field(default_factory=list)
+    # The target's own faces on a curved surface, fed to the fuse beside its sheets on a retry
+    # (``zonegraph.zones.build``): the general fuse can drop a full cylinder's split where it
+    # meets the part's faces at a cusp, and the face itself pins it.
+    anchors: list[TopoDS_Shape] = field(default_factory=list)
 
     @property
     def is_plane(self) -> bool:
@@ -255,6 +262,9 @@ def extend_faces(
             ext.keep_face(face, i)
     for s in planes.values():
         ext.plane_sheets(s, faces, loops)
+    for s in ext.surfaces:
+        if s.kind in CURVED:
+            s.anchors = [BRepBuilderAPI_Copy(faces[i]).Shape() for i in s.source_faces]
     return ext.surfaces, len(faces)
 
 
