@@ -12,6 +12,7 @@ written there, the JSON's hole was not coplanar and the reader built the profile
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -61,6 +62,23 @@ def test_the_files_of_a_zone_exact_program_rebuild_the_part(
     saved = json.loads((tmp_path / "out" / "result.json").read_text())
     assert result.exact and not saved["export_error"], saved["export_error"]
     assert saved["script_iou"] >= EXACT_IOU and saved["json_iou"] >= EXACT_IOU
+
+
+@requires_corpus
+def test_a_written_json_whose_boolean_commons_with_the_part_are_empty_measures_exact(tmp_path: Path) -> None:
+    """43928_6ca53538_0025's JSON replays 2e-6 off the part's volume, yet every Boolean common of
+    the two came back empty (IoU 3e-7): the cells of one fuse of both measure it. (Its script's
+    sequential Booleans leave a cut undone, 0.994: not part of this test.)"""
+    from zonegraph.data.b123d import convert_design
+
+    design_id = "43928_6ca53538_0025"
+    converted = convert_design(CORPUS / "07_16to20ops/batch_002.py", design_id)
+    assert converted.ok and converted.design_json is not None, converted.reason
+    path = tmp_path / f"{design_id}.json"
+    path.write_text(json.dumps(converted.design_json))
+    result = infer(path, tmp_path / "out", InferConfig(budget_s=math.inf, max_expansions=200), render=False)
+    saved = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert result.exact and saved["json_iou"] >= EXACT_IOU
 
 
 def _extrude(name: str, op: Operation) -> Extrude:
