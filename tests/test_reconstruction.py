@@ -100,6 +100,8 @@ def test_exported_json_replays_to_the_same_solid(inferred):
     for name, (path, out, _) in inferred.items():
         replayed = replay(load_design(out / "sequence.json"))
         assert brep_iou(replayed.shape, as_shape(load_target(path))) >= 0.9999, name
+        # the file carries its own replay's figures, so `zonegraph replay` verifies it by default
+        assert replayed.design.properties is not None and replayed.disagreement() is None, name
 
 
 @requires_samples

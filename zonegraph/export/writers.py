@@ -569,9 +569,10 @@ def program_design(steps: list[WrittenStep], name: str) -> Design:
     return Design(name, tuple(timeline))
 
 
-def design_text(steps: list[WrittenStep], name: str) -> str:
-    """``sequence.json``'s text."""
-    return json.dumps(design_to_json(program_design(steps, name)), indent=1)
+def design_text(steps: list[WrittenStep], name: str, properties: dict | None = None) -> str:
+    """``sequence.json``'s text; ``properties``: the final figures its replay is checked against
+    (:mod:`zonegraph.verified`)."""
+    return json.dumps(design_to_json(program_design(steps, name), properties=properties), indent=1)
 
 
 # ------------------------------------------------------------------------------ STEP and PNG
