@@ -38,6 +38,7 @@ from zonegraph.geometry.occ import (
     make_compound,
     overlaps_merged,
     pnt,
+    precise_volume,
     shape_index,
     shape_list,
     shapes_of,
@@ -383,9 +384,25 @@ def _partition(
         plane_side=mesh.plane_sides(surfaces),
         solids=topo.zones,
     )
-    graph.info.update(_mesh_volume_ratios(graph, mesh, target_volume, solids))
+    _precise_where_off(graph, topo.zones, solids)
+    graph.info.update(_mesh_volume_ratios(graph, mesh, graph.target_volume, solids))
     timer.lap("graph_s")
     return graph
+
+
+def _precise_where_off(graph: ZoneGraph, zones: list, solids: list) -> None:
+    """Zone and target volumes integrated to 1e-9 (:func:`precise_volume`) where the default
+    integration, ~1e-4 accurate on surfaces of extrusion and B-splines, breaks the box or the
+    target check: on the whole corpus graphs whose zones summed to 1.000066 or 0.99995 of the
+    box that way sum to it within 5e-7 and 3e-6 integrated precisely. Only then: it costs a few
+    milliseconds per zone."""
+    box_off = abs(graph.zone_volume.sum() / graph.box_volume - 1) > BOX_VOLUME_RTOL
+    target_off = abs(graph.inside_volume / graph.target_volume - 1) > TARGET_VOLUME_RTOL
+    if not (box_off or target_off):
+        return
+    graph.zone_volume = np.array([precise_volume(z) for z in zones])
+    graph.target_volume = sum(precise_volume(s) for s in overlaps_merged(solids))
+    graph.info["precise_volumes"] = True
 
 
 def _mesh_volume_ratios(graph: ZoneGraph, mesh: _ZoneMesh, target_volume: float, solids: list) -> dict:
