@@ -13,6 +13,7 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Callable, Iterator, Sequence
+from functools import cached_property
 from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
@@ -257,11 +258,8 @@ def build_zone_graph(
     norm = Normalization.of(shape)
     target_n = norm.apply(shape)
     solids = sub_shapes(target_n, TopAbs_SOLID)
-    # The region the solids fill: overlapping bodies' volumes summed count the overlap twice.
-    # Their faces and classifiers stay the bodies' own (a fused pair classified zones outside it
-    # as inside on a corpus part).
-    target_volume = sum(volume_props(s)[0] for s in overlaps_merged(solids))
-    if not target_volume > 0:
+    region = _Region(solids)
+    if not region.volume > 0:
         raise ZoneGraphBuildError(Status.INVALID_INPUT, source, "target has no volume")
     box = bounds(target_n)
     extensions = _extensions(target_n, box, list(loop_rules) if simplify else [None])
@@ -279,7 +277,7 @@ def build_zone_graph(
         ladder = _ladder(fuzzy) if last else _ladder(fuzzy)[:1]
         try:
             graph = _checked_partition(
-                norm, box, target_volume, solids, surfaces, ladder, samples, seed, source, timer, check
+                norm, box, region, solids, surfaces, ladder, samples, seed, source, timer, check
             )
         except ZoneGraphBuildError as exc:
             if last or exc.status == Status.INVALID_INPUT:
@@ -310,7 +308,7 @@ def _extensions(
 def _checked_partition(
     norm: Normalization,
     box: np.ndarray,
-    target_volume: float,
+    region: _Region,
     solids: list,
     surfaces: list[ExtendedSurface],
     ladder: list[tuple[str, float]],
@@ -324,7 +322,7 @@ def _checked_partition(
     for attempt, (method, value) in enumerate(ladder):
         try:
             graph = _partition(
-                norm, box, target_volume, solids, surfaces, (method, value), samples, seed, source, timer
+                norm, box, region, solids, surfaces, (method, value), samples, seed, source, timer
             )
             graph.info.update(fuzzy=value, partition=method, attempts=attempt + 1)
             if check:
@@ -339,7 +337,7 @@ def _checked_partition(
 def _partition(
     norm: Normalization,
     box: np.ndarray,
-    target_volume: float,
+    region: _Region,
     solids: list,
     surfaces: list,
     method: tuple[str, float],
@@ -360,13 +358,13 @@ def _partition(
     topo = _Topology(builder, box_solid, surfaces, tools)
     timer.lap("topology_s")
     mesh = _ZoneMesh(topo)
-    interior, inside = _interior_and_inside(mesh, solids, topo.zone_volume, target_volume)
+    interior, inside = _interior_and_inside(mesh, solids, topo.zone_volume, region.volume)
     points, normals = sample_zone_surfaces(mesh.zone_tris, samples, np.random.default_rng(seed))
     timer.lap("zones_s")
     graph = ZoneGraph(
         normalization=norm,
         box=box,
-        target_volume=target_volume,
+        target_volume=region.volume,
         zone_volume=topo.zone_volume,
         zone_centroid=topo.zone_centroid,
         zone_bbox=mesh.zone_bbox(),
@@ -384,28 +382,50 @@ def _partition(
         plane_side=mesh.plane_sides(surfaces),
         solids=topo.zones,
     )
-    _precise_where_off(graph, topo.zones, solids)
-    graph.info.update(_mesh_volume_ratios(graph, mesh, graph.target_volume, solids))
+    _precise_where_off(graph, topo.zones, region)
+    graph.info.update(_mesh_volume_ratios(graph, mesh, solids))
     timer.lap("graph_s")
     return graph
 
 
-def _precise_where_off(graph: ZoneGraph, zones: list, solids: list) -> None:
+class _Region:
+    """The region the target's solids fill, and its volume by the default integration; to 1e-9
+    when asked (a few milliseconds a solid, paid only on a graph that fails a check).
+
+    Overlapping bodies are fused for it (:func:`overlaps_merged`): their volumes summed count the
+    overlap twice. Their faces and classifiers stay the bodies' own (a fused pair classified zones
+    outside it as inside on a corpus part)."""
+
+    def __init__(self, solids: list[TopoDS_Shape]):
+        self.solids = overlaps_merged(solids)
+        self.volume = sum(volume_props(s)[0] for s in self.solids)
+
+    @cached_property
+    def precise_volume(self) -> float:
+        return sum(precise_volume(s) for s in self.solids)
+
+
+def _volumes_off(graph: ZoneGraph) -> tuple[bool, bool]:
+    """Whether the zones' volumes miss the box, and the inside zones' the target, beyond the
+    exact checks' tolerances."""
+    box_off = abs(graph.zone_volume.sum() / graph.box_volume - 1) > BOX_VOLUME_RTOL
+    return box_off, abs(graph.inside_volume / graph.target_volume - 1) > TARGET_VOLUME_RTOL
+
+
+def _precise_where_off(graph: ZoneGraph, zones: list, region: _Region) -> None:
     """Zone and target volumes integrated to 1e-9 (:func:`precise_volume`) where the default
     integration, ~1e-4 accurate on surfaces of extrusion and B-splines, breaks the box or the
-    target check: on the whole corpus graphs whose zones summed to 1.000066 or 0.99995 of the
-    box that way sum to it within 5e-7 and 3e-6 integrated precisely. Only then: it costs a few
-    milliseconds per zone."""
-    box_off = abs(graph.zone_volume.sum() / graph.box_volume - 1) > BOX_VOLUME_RTOL
-    target_off = abs(graph.inside_volume / graph.target_volume - 1) > TARGET_VOLUME_RTOL
-    if not (box_off or target_off):
+    target check: a corpus graph whose zones summed to 1.000066 of the box that way sums to it
+    within 5e-7 integrated precisely (9 of the whole corpus's refusals build with it). Only then:
+    it costs a few milliseconds per zone."""
+    if not any(_volumes_off(graph)):
         return
     graph.zone_volume = np.array([precise_volume(z) for z in zones])
-    graph.target_volume = sum(precise_volume(s) for s in overlaps_merged(solids))
+    graph.target_volume = region.precise_volume
     graph.info["precise_volumes"] = True
 
 
-def _mesh_volume_ratios(graph: ZoneGraph, mesh: _ZoneMesh, target_volume: float, solids: list) -> dict:
+def _mesh_volume_ratios(graph: ZoneGraph, mesh: _ZoneMesh, solids: list) -> dict:
     """Zone volumes measured a second way, where the exact integrals disagree with the box or the
     target: OpenCASCADE integrates surfaces of extrusion and B-splines to only ~1e-4, and at
     several precisions a free-form target can measure a percent off itself, which otherwise
@@ -414,9 +434,9 @@ def _mesh_volume_ratios(graph: ZoneGraph, mesh: _ZoneMesh, target_volume: float,
     the box exactly; the target is meshed on its own at the same deflection, and only where it
     has free-form faces (planes and cylinders integrate exactly: a deficit there is real)."""
     out: dict = {}
-    box_off = abs(graph.zone_volume.sum() / graph.box_volume - 1) > BOX_VOLUME_RTOL
+    box_off, target_off = _volumes_off(graph)
     freeform = bool(np.isin(graph.surface_kind, [SurfaceKind.EXTRUSION.value, SurfaceKind.FACE.value]).any())
-    target_off = freeform and abs(graph.inside_volume / target_volume - 1) > TARGET_VOLUME_RTOL
+    target_off = freeform and target_off
     if not (box_off or target_off):
         return out
     volumes = mesh.zone_volumes()
