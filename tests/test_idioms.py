@@ -124,3 +124,35 @@ def test_the_script_run_without_an_argument_writes_its_step_beside_it(tmp_path: 
         [sys.executable, str(script)], capture_output=True, text=True, timeout=300, check=True
     )
     assert (tmp_path / "sequence.step").stat().st_size > 0 and "sequence.step" in done.stdout
+
+
+def _blob(plane: Plane, seam: int, shift: float = 0.0) -> Face:
+    """One closed free-form loop through eight points, its seam moved to knot ``seam``."""
+    import math
+
+    from build123d import Edge, Wire
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.Geom import Geom_BSplineCurve
+
+    points = [
+        plane.from_local_coords((10 * math.cos(a) + 2 * math.cos(3 * a) + shift, 6 * math.sin(a)))
+        for a in (2 * math.pi * i / 8 for i in range(8))
+    ]
+    curve = BRep_Tool.Curve_s(Edge.make_spline(points, periodic=True).wrapped, 0.0, 1.0)
+    spline = curve.Copy()
+    assert isinstance(spline, Geom_BSplineCurve)
+    spline.SetOrigin(seam)
+    return Face(Wire([Edge(BRepBuilderAPI_MakeEdge(spline).Edge())]))
+
+
+def test_one_closed_spline_sketched_by_two_steps_is_written_as_one_curve() -> None:
+    """Two steps sketch the same closed free-form loop, each from its own seam and 3e-6 mm apart
+    (a corpus part's two faces on one side face): written alike, their union holds in both files."""
+    lower = ProgramStep(Op.UNION, (_blob(Plane.XY, 1),), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), 10.0)
+    top = Plane.XY.offset(12)
+    upper = ProgramStep(Op.UNION, (_blob(top, 4, 3e-6),), (0.0, 0.0, 12.0), (0.0, 0.0, -1.0), 8.0)
+    result = export([lower, upper])
+    splines = [line.strip() for line in result.script.splitlines() if line.strip().startswith("Spline(")]
+    assert len(splines) == 2 and splines[0] == splines[1]
+    assert result.check.script_iou >= EXACT_IOU and result.check.json_iou >= EXACT_IOU

@@ -13,7 +13,7 @@ import json
 import math
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +23,7 @@ from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.GCPnts import GCPnts_AbscissaPoint, GCPnts_UniformAbscissa
 from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
 from OCP.gp import gp_Pnt
+from scipy.optimize import minimize_scalar
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
 from zonegraph.data.design import (
@@ -67,6 +68,11 @@ SPLINE_SAMPLES = 24  # the fewest points the script's interpolating spline runs 
 # splines instead of 24 made a partial program's IoU take 275 s instead of about 50).
 SPLINE_FIT = 1e-5
 SPLINE_MAX_SAMPLES = 384
+# A closed free-form loop is sampled from its point farthest along this direction of the sketch
+# plane (x, y): any seam-free point would do; a direction along neither axis keeps a straight run
+# of the loop (common along an axis) from making that point ambiguous.
+SEAM_DIRECTION = (math.cos(0.7), math.sin(0.7))
+EXTREME_SAMPLES = 256
 
 
 def step_frame(step: ProgramStep, snap: Snapper | None = None) -> Frame:
@@ -202,26 +208,69 @@ def local_edge(piece: LoopEdge, frame: Frame, snap: Snapper | None = None) -> Lo
         return _line(_local(frame, piece.start), _local(frame, piece.end), snap)
     if kind == GeomType.CIRCLE:
         return _arc(piece, frame, snap)
+    if edge.is_closed:
+        return _closed_spline(piece, frame, snap)
     begin = np.array(tuple(edge.position_at(0)))
     first, last = (snap.point(_local(frame, q)) for q in _from_nearest(begin, piece.start, piece.end))
     inside = [snap.point(_local(frame, q)) for q in spline_points(edge)[1:-1]]
     return LocalEdge("spline", np.array([first, *inside, last]), _nurbs(piece, frame, snap))
 
 
-def spline_points(edge: Edge) -> list[np.ndarray]:
-    """Points evenly spaced along ``edge`` by arc length, from its start (``position_at(0)``), that
-    an interpolating spline through them follows within ``SPLINE_FIT`` of the edge's length,
-    checked half-way between them: ``SPLINE_SAMPLES`` doubled until it does (at most
-    ``SPLINE_MAX_SAMPLES``). One pass of OpenCASCADE's uniform abscissa per try: build123d's
-    ``position_at`` measures the whole curve at every call, which made the check minutes long on
-    a corpus part with many free-form sketch edges."""
+def _closed_spline(
+    piece: LoopEdge, frame: Frame, snap: Snapper, shared: SharedLoops | None = None
+) -> LocalEdge:
+    """A closed free-form loop, sampled from a point of the curve that does not depend on its seam,
+    running anticlockwise; the loop an earlier step wrote where ``shared`` holds one it follows.
+
+    Two steps of a corpus part sketch one closed spline, each on a face the partition cut with its
+    own seam (25364_b3985755_0002). Sampled from each seam, the two interpolating splines crossed
+    each other and their union failed (script IoU 0); sampled from the curve's extreme point along
+    :data:`SEAM_DIRECTION` they are the same points, up to the 8e-6 cm the two faces' curves part."""
+    curve = piece.edge.geom_adaptor()
+    direction = SEAM_DIRECTION[0] * np.asarray(frame.x_axis, float) + SEAM_DIRECTION[1] * np.asarray(
+        frame.y_axis, float
+    )
+    start = _extreme_parameter(curve, direction)
+    raw = np.array([_local(frame, q) for q in spline_points(piece.edge, start)])
+    raw[-1] = raw[0]
+    if _signed_area(raw) < 0:  # one running sense too: an edge's own runs either way
+        raw = raw[::-1]
+    earlier = shared.follows(frame, raw) if shared is not None else None
+    if earlier is not None:
+        return earlier
+    samples = np.array([snap.point(q) for q in raw])
+    samples[-1] = samples[0]
+    loop = LocalEdge("spline", samples, _nurbs(piece, frame, snap))
+    if shared is not None:
+        shared.add(frame, raw, loop)
+    return loop
+
+
+def _signed_area(points: np.ndarray) -> float:
+    """Twice the signed area of a closed polygon in the sketch plane (positive: anticlockwise)."""
+    x, y = points[:, 0], points[:, 1]
+    return float(np.sum(x[:-1] * y[1:] - x[1:] * y[:-1]))
+
+
+def spline_points(edge: Edge, start: float | None = None) -> list[np.ndarray]:
+    """Points evenly spaced along ``edge`` by arc length, from its start (``position_at(0)``) or,
+    on a closed edge, from parameter ``start`` round to it again, that an interpolating spline
+    through them follows within ``SPLINE_FIT`` of the edge's length, checked half-way between
+    them: ``SPLINE_SAMPLES`` doubled until it does (at most ``SPLINE_MAX_SAMPLES``). One pass of
+    OpenCASCADE's uniform abscissa per try: build123d's ``position_at`` measures the whole curve
+    at every call, which made the check minutes long on a corpus part with many free-form sketch
+    edges."""
     curve = edge.geom_adaptor()
-    tol = SPLINE_FIT * GCPnts_AbscissaPoint.Length_s(curve)
+    length = GCPnts_AbscissaPoint.Length_s(curve)
     n = SPLINE_SAMPLES
     while True:
-        points = _even_points(curve, 2 * n - 1, edge.is_forward)
+        points = (
+            _even_points(curve, 2 * n - 1, edge.is_forward)
+            if start is None
+            else _points_from(curve, start, length, 2 * n - 1)
+        )
         samples, halfway = points[::2], points[1::2]
-        if n >= SPLINE_MAX_SAMPLES or _strays(samples, halfway) <= tol:
+        if n >= SPLINE_MAX_SAMPLES or _strays(samples, halfway) <= SPLINE_FIT * length:
             return samples
         n *= 2
 
@@ -233,6 +282,41 @@ def _even_points(curve: BRepAdaptor_Curve, count: int, forward: bool) -> list[np
     params = [abscissa.Parameter(i) for i in range(1, abscissa.NbPoints() + 1)]
     points = [np.array(curve.Value(u).Coord()) for u in params]
     return points if forward else points[::-1]
+
+
+def _points_from(curve: BRepAdaptor_Curve, start: float, length: float, count: int) -> list[np.ndarray]:
+    """``count`` points evenly spaced by arc length round a closed curve, from parameter ``start``
+    back to it (the last point is the first)."""
+    first = curve.FirstParameter()
+    offset = GCPnts_AbscissaPoint.Length_s(curve, first, start)
+    points = []
+    for i in range(count - 1):
+        along = (offset + i * length / (count - 1)) % length
+        at = GCPnts_AbscissaPoint(curve, along, first)
+        if not at.IsDone():
+            raise ValueError("OpenCASCADE could not space points along a sketch edge")
+        points.append(np.array(curve.Value(at.Parameter()).Coord()))
+    return [*points, points[0]]
+
+
+def _extreme_parameter(curve: BRepAdaptor_Curve, direction: np.ndarray) -> float:
+    """The parameter of the curve's point farthest along ``direction``: coarse samples, then a
+    bounded search between the best one's neighbours."""
+    first, last = curve.FirstParameter(), curve.LastParameter()
+    params = np.linspace(first, last, EXTREME_SAMPLES + 1)
+
+    def height(u: float) -> float:
+        return -float(np.asarray(curve.Value(u).Coord()) @ direction)
+
+    best = int(np.argmin([height(u) for u in params[:-1]]))
+    step = params[1] - params[0]
+    found = minimize_scalar(
+        lambda t: height(first + (t - first) % (last - first)),
+        bounds=(params[best] - step, params[best] + step),
+        method="bounded",
+        options={"xatol": 1e-12 * (last - first)},
+    )
+    return float(first + (found.x - first) % (last - first))
 
 
 def _strays(samples: list[np.ndarray], halfway: list[np.ndarray]) -> float:
@@ -279,14 +363,65 @@ class WrittenStep:
     tol: float = 0.0  # how far the snapper could move a number (a sketch object matches within it)
 
 
+@dataclass
+class SharedLoops:
+    """The closed free-form loops written so far, so that a loop another step sketched (within
+    what snapping may move a number) is written as the same curve.
+
+    Two steps of a corpus part (25364_b3985755_0002) sketch one closed spline, cut from the part's
+    side face at both ends of it, 8e-6 cm apart: snapped apart, their union failed in the script
+    (IoU 0) and left 1.2% of the part out of the JSON's replay."""
+
+    tol: float
+    loops: list[tuple[tuple[float, ...], Edge, LocalEdge]] = field(default_factory=list)
+
+    @staticmethod
+    def _plane(frame: Frame) -> tuple[float, ...]:
+        return tuple(round(c, 9) for c in (*frame.x_axis, *frame.y_axis))
+
+    def follows(self, frame: Frame, samples: np.ndarray) -> LocalEdge | None:
+        """The loop written earlier in a parallel frame whose samples ``samples`` (raw, in
+        ``frame``) follow within ``tol``; None when none does."""
+        plane = self._plane(frame)
+        for other_plane, fitted, loop in self.loops:
+            if other_plane == plane and self._near(samples, fitted):
+                return loop
+        return None
+
+    def add(self, frame: Frame, samples: np.ndarray, loop: LocalEdge) -> None:
+        if self.tol > 0:
+            self.loops.append((self._plane(frame), Edge.make_spline([Vector(*q) for q in samples]), loop))
+
+    def _near(self, samples: np.ndarray, fitted: Edge) -> bool:
+        curve = BRep_Tool.Curve_s(fitted.wrapped, 0.0, 1.0)
+        project = GeomAPI_ProjectPointOnCurve()
+        for q in samples:
+            project.Init(gp_Pnt(*q), curve)
+            if not project.NbPoints() or project.LowerDistance() > self.tol:
+                return False
+        return True
+
+
+def _sketch_edge(piece: LoopEdge, frame: Frame, snap: Snapper, shared: SharedLoops) -> LocalEdge:
+    if piece.edge.is_closed and piece.edge.geom_type not in (GeomType.CIRCLE, GeomType.LINE):
+        return _closed_spline(piece, frame, snap, shared)
+    return local_edge(piece, frame, snap)
+
+
 def written_steps(program: list[ProgramStep], snap: Snapper | None = None) -> list[WrittenStep]:
-    """The program in sketch coordinates, every number passed through ``snap`` once."""
+    """The program in sketch coordinates, every number passed through ``snap`` once (and a closed
+    free-form loop that an earlier step sketched within what snapping may move written as that
+    loop, :class:`SharedLoops`)."""
     snap = snap or Snapper.raw()
+    shared = SharedLoops(snap.tol)
     out = []
     for step in program:
         frame = step_frame(step, snap)
         faces = tuple(
-            tuple((outer, tuple(local_edge(e, frame, snap) for e in edges)) for outer, edges in face_wires(f))
+            tuple(
+                (outer, tuple(_sketch_edge(e, frame, snap, shared) for e in edges))
+                for outer, edges in face_wires(f)
+            )
             for f in step.faces
         )
         areas = tuple(f.area for f in step.faces)
