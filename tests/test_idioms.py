@@ -156,3 +156,23 @@ def test_one_closed_spline_sketched_by_two_steps_is_written_as_one_curve() -> No
     splines = [line.strip() for line in result.script.splitlines() if line.strip().startswith("Spline(")]
     assert len(splines) == 2 and splines[0] == splines[1]
     assert result.check.script_iou >= EXACT_IOU and result.check.json_iou >= EXACT_IOU
+
+
+def test_a_point_set_script_makes_the_part_from_one_fuse_of_its_tools() -> None:
+    """The last style tried: no Boolean per step, the cells of all tools that the last tool holding
+    them adds (a union, a cut through it, a union refilling part of the cut)."""
+    from zonegraph.export.verify import run_script
+    from zonegraph.export.writers import ScriptStyle
+
+    cut = ProgramStep(
+        Op.SUBTRACT, (face(Plane.XY.offset(6), Pos(0, 5) * Rectangle(10, 4)),), (0, 0, 6.0), (0, 0, -1.0), 6.0
+    )
+    refill = ProgramStep(Op.UNION, (face(Plane.XY, Pos(0, 5) * Circle(1)),), (0, 0, 0), (0, 0, 1.0), 3.0)
+    program = [PLATE, cut, refill]
+    style = ScriptStyle(holes=False, fuzzy=(0.0, 1e-6), cells=True)
+    script = program_script(written_steps(program), "part", Unit.MM, style)
+    assert "result = point_set(steps)" in script and "steps.append((extrude(" in script
+    expected = execute(program)[-1]
+    assert expected is not None
+    built = run_script(script)
+    assert built.is_valid and abs(built.volume - expected.volume) < 1e-6 * expected.volume

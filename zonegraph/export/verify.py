@@ -82,10 +82,12 @@ STYLES = (IDIOMATIC, ScriptStyle(holes=False), LITERAL)
 
 
 def fuzzy_styles(target: Shape) -> tuple[ScriptStyle, ...]:
-    """The checked style for a part: sketch objects kept, each step's Boolean at the fuzzy values
-    of the program's own rebuild (``FUZZY_SHARES`` of the part's diagonal)."""
+    """The checked styles for a part, sketch objects kept: each step's Boolean at the fuzzy values
+    of the program's own rebuild (``FUZZY_SHARES`` of the part's diagonal), then the point set of
+    all the tools at those values, as the rebuild's own last resort."""
     diag = float(target.bounding_box().diagonal)
-    return (ScriptStyle(holes=False, fuzzy=tuple(share * diag for share in FUZZY_SHARES)),)
+    fuzzy = tuple(share * diag for share in FUZZY_SHARES)
+    return ScriptStyle(holes=False, fuzzy=fuzzy), ScriptStyle(holes=False, fuzzy=fuzzy, cells=True)
 
 
 def export_texts(

@@ -460,6 +460,9 @@ class ScriptStyle:
     holes: bool = True  # a cut of lone circles into a named plane as Hole
     # not empty: each step's Boolean tries these fuzzy values (input units; :data:`FUZZY_CODE`)
     fuzzy: tuple[float, ...] = ()
+    # with fuzzy values: no Boolean per step; the part is the point set of all the steps' tools,
+    # from one general fuse of them at those values (:data:`POINT_SET_CODE`)
+    cells: bool = False
 
 
 IDIOMATIC = ScriptStyle()
@@ -593,34 +596,80 @@ def boolean(part, tool, mode):
 """
 
 
+# The helper a point-set script defines, the last style tried: a chain of Booleans fails where one
+# link does, and on a corpus part (21638_0a984848_0011) the written tools' sixth cut failed in
+# every chain, at every fuzzy value, while one general fuse of all seven tools gave the part (IoU
+# 0.999998). As :func:`zonegraph.data.replay.cells_bodies` does for a replay: each cell of the
+# fuse is material when the last tool that holds it adds, i.e. the cells inside an adding tool and
+# outside every later tool.
+POINT_SET_CODE = """
+def point_set(steps):
+    \"\"\"The part that steps (tool, Mode.ADD or Mode.SUBTRACT) make, in order: the pieces of one
+    general fuse of all the tools that the last tool holding them adds, faces closer than each of
+    FUZZY in turn taken as one; the first valid result (shared faces merged where that keeps it
+    valid).\"\"\"
+    tools = [BRepBuilderAPI_Copy(tool.wrapped).Shape() for tool, _ in steps]
+    for fuzzy in FUZZY:
+        cells = BOPAlgo_CellsBuilder()
+        for tool in tools:
+            cells.AddArgument(tool)
+        cells.SetFuzzyValue(fuzzy)
+        cells.SetNonDestructive(True)
+        cells.Perform()
+        if cells.HasErrors():
+            continue
+        for i, (_, mode) in enumerate(steps):
+            if mode == Mode.ADD:
+                take, avoid = List_TopoDS_Shape(), List_TopoDS_Shape()
+                take.Append(tools[i])
+                for later in tools[i + 1 :]:
+                    avoid.Append(later)
+                cells.AddToResult(take, avoid, 1, False)
+        cells.RemoveInternalBoundaries()
+        part = Part(cells.Shape())
+        merged = Part(BRepBuilderAPI_Copy(part.wrapped).Shape()).clean()
+        if merged.is_valid or part.is_valid:
+            return merged if merged.is_valid else part
+    raise RuntimeError("the general fuse of the tools failed at every fuzzy value")
+"""
+
+
 def _fuzzy_step_code(
     i: int, step: WrittenStep, plane: str, what: str, mode: str, style: ScriptStyle
 ) -> list[str]:
     """A step in build123d's algebra mode: the sketch extruded alone, then :data:`FUZZY_CODE`'s
-    ``boolean`` with the part so far."""
+    ``boolean`` with the part so far (or, point-set style, the tool kept for
+    :data:`POINT_SET_CODE`)."""
+    tool = f"extrude(sketch.sketch, amount={written(step.distance)})"
+    combined = f"steps.append(({tool}, {mode}))" if style.cells else f"part = boolean(part, {tool}, {mode})"
     return [
         f"# Step {i}: {what}",
         f"with BuildSketch({plane}) as sketch:",
         *[line[4:] for line in _sketch_code(step, style)],
-        f"part = boolean(part, extrude(sketch.sketch, amount={written(step.distance)}), {mode})",
+        combined,
         "",
     ]
 
 
 def _fuzzy_body(steps: list[WrittenStep], unit: str, style: ScriptStyle) -> list[str]:
+    imports = (
+        ["from OCP.BOPAlgo import BOPAlgo_CellsBuilder"]
+        if style.cells
+        else ["from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse"]
+    )
     lines = [
-        "from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse",
+        *imports,
         "from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy",
         "from OCP.collections import List_TopoDS_Shape",
         "",
         f"FUZZY = ({', '.join(written(f) for f in style.fuzzy)})  # {unit}",
-        *FUZZY_CODE.splitlines(),
+        *(POINT_SET_CODE if style.cells else FUZZY_CODE).splitlines(),
         "",
-        "part = None",
+        "steps = []" if style.cells else "part = None",
     ]
     for i, step in enumerate(steps, 1):
         lines += _step_code(i, step, unit, style)
-    return [*lines, "result = part"]
+    return [*lines, "result = point_set(steps)" if style.cells else "result = part"]
 
 
 def program_script(steps: list[WrittenStep], name: str, unit: Unit, style: ScriptStyle = IDIOMATIC) -> str:
