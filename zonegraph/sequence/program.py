@@ -329,6 +329,8 @@ def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
             break
     if inter < full and fuzzy > 0.0:
         inter = max(inter, _cells_common(a, b, fuzzy))
+    if inter < full and fuzzy > 0.0:
+        inter = max(inter, _fused_common(a, b, fuzzy, volume_a, volume_b))
     inter = min(inter, volume_a, volume_b)  # volume integration error can exceed an operand's volume
     union = volume_a + volume_b - inter
     return inter / union if union > 0 else 1.0
@@ -370,6 +372,39 @@ def _cells_common(a: Shape, b: Shape, fuzzy: float) -> float:
     except RuntimeError:
         return 0.0
     return precise_volume(cells)
+
+
+# How closely a cut must agree with the intersection a fuse implies (relative to the larger
+# solid): volume integration to 1e-9 leaves the two a few 1e-7 apart on the measured cases.
+FUSED_AGREE_RTOL = 1e-6
+
+
+def _fused_common(a: Shape, b: Shape, fuzzy: float, volume_a: float, volume_b: float) -> float:
+    """The common's volume as vol(a) + vol(b) - vol(a or b), where a cut of one by the other at
+    ``fuzzy`` (or exactly) leaves what that implies; 0 where none does or the fuse fails.
+
+    Two written files of corpus parts, each with the program's volume at every step, had every
+    Boolean common with the target come back nearly empty, the cells' too, after their faces
+    were unified, while their fuse with the target held what the program's own rebuild measured.
+    A fuse that drops volume would overstate the common, so a second Boolean has to agree: a cut
+    failing by the same amount as the fuse is not a failure mode that has been seen."""
+    try:
+        union = precise_volume(fuzzy_boolean(BRepAlgoAPI_Fuse(), a.wrapped, b.wrapped, fuzzy))
+    except (ValueError, RuntimeError):
+        return 0.0
+    inter = volume_a + volume_b - union
+    tol = FUSED_AGREE_RTOL * max(volume_a, volume_b)
+    if not -tol <= inter <= min(volume_a, volume_b) + tol:
+        return 0.0
+    for x, y, left in ((a, b, volume_a - inter), (b, a, volume_b - inter)):
+        for value in (fuzzy, 0.0):
+            try:
+                cut = precise_volume(fuzzy_boolean(BRepAlgoAPI_Cut(), x.wrapped, y.wrapped, value))
+            except (ValueError, RuntimeError):
+                continue
+            if abs(cut - left) <= tol:
+                return max(inter, 0.0)
+    return 0.0
 
 
 def _copy(shape: Shape) -> Shape:
