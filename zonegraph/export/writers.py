@@ -194,9 +194,12 @@ def _nurbs(piece: LoopEdge, frame: Frame, snap: Snapper) -> Nurbs:
     )
 
 
-def local_edge(piece: LoopEdge, frame: Frame, snap: Snapper | None = None) -> LocalEdge:
+def local_edge(
+    piece: LoopEdge, frame: Frame, snap: Snapper | None = None, shared: SharedLoops | None = None
+) -> LocalEdge:
     """An edge of a sketch loop in the sketch's frame between the loop's corners, its numbers
-    snapped (a corner snaps to the same point for both edges that meet there)."""
+    snapped (a corner snaps to the same point for both edges that meet there); a closed free-form
+    loop that ``shared`` holds from an earlier step is written as that loop."""
     snap = snap or Snapper.raw()
     edge = piece.edge
     kind = edge.geom_type
@@ -209,7 +212,7 @@ def local_edge(piece: LoopEdge, frame: Frame, snap: Snapper | None = None) -> Lo
     if kind == GeomType.CIRCLE:
         return _arc(piece, frame, snap)
     if edge.is_closed:
-        return _closed_spline(piece, frame, snap)
+        return _closed_spline(piece, frame, snap, shared)
     begin = np.array(tuple(edge.position_at(0)))
     first, last = (snap.point(_local(frame, q)) for q in _from_nearest(begin, piece.start, piece.end))
     inside = [snap.point(_local(frame, q)) for q in spline_points(edge)[1:-1]]
@@ -238,8 +241,7 @@ def _closed_spline(
     earlier = shared.follows(frame, raw) if shared is not None else None
     if earlier is not None:
         return earlier
-    samples = np.array([snap.point(q) for q in raw])
-    samples[-1] = samples[0]
+    samples = np.array([snap.point(q) for q in raw])  # raw ends alike, so the snapped ones are
     loop = LocalEdge("spline", samples, _nurbs(piece, frame, snap))
     if shared is not None:
         shared.add(frame, raw, loop)
@@ -372,8 +374,8 @@ class SharedLoops:
     side face at both ends of it, 8e-6 cm apart: snapped apart, their union failed in the script
     (IoU 0) and left 1.2% of the part out of the JSON's replay."""
 
-    tol: float
-    loops: list[tuple[tuple[float, ...], Edge, LocalEdge]] = field(default_factory=list)
+    tol: float  # 0 (a raw snapper): nothing is shared
+    loops: list[tuple[tuple[float, ...], np.ndarray, LocalEdge]] = field(default_factory=list)
 
     @staticmethod
     def _plane(frame: Frame) -> tuple[float, ...]:
@@ -383,29 +385,14 @@ class SharedLoops:
         """The loop written earlier in a parallel frame whose samples ``samples`` (raw, in
         ``frame``) follow within ``tol``; None when none does."""
         plane = self._plane(frame)
-        for other_plane, fitted, loop in self.loops:
-            if other_plane == plane and self._near(samples, fitted):
+        for other_plane, other, loop in self.loops:
+            if other_plane == plane and _strays(list(other), list(samples)) <= self.tol:
                 return loop
         return None
 
     def add(self, frame: Frame, samples: np.ndarray, loop: LocalEdge) -> None:
         if self.tol > 0:
-            self.loops.append((self._plane(frame), Edge.make_spline([Vector(*q) for q in samples]), loop))
-
-    def _near(self, samples: np.ndarray, fitted: Edge) -> bool:
-        curve = BRep_Tool.Curve_s(fitted.wrapped, 0.0, 1.0)
-        project = GeomAPI_ProjectPointOnCurve()
-        for q in samples:
-            project.Init(gp_Pnt(*q), curve)
-            if not project.NbPoints() or project.LowerDistance() > self.tol:
-                return False
-        return True
-
-
-def _sketch_edge(piece: LoopEdge, frame: Frame, snap: Snapper, shared: SharedLoops) -> LocalEdge:
-    if piece.edge.is_closed and piece.edge.geom_type not in (GeomType.CIRCLE, GeomType.LINE):
-        return _closed_spline(piece, frame, snap, shared)
-    return local_edge(piece, frame, snap)
+            self.loops.append((self._plane(frame), samples, loop))
 
 
 def written_steps(program: list[ProgramStep], snap: Snapper | None = None) -> list[WrittenStep]:
@@ -419,7 +406,7 @@ def written_steps(program: list[ProgramStep], snap: Snapper | None = None) -> li
         frame = step_frame(step, snap)
         faces = tuple(
             tuple(
-                (outer, tuple(_sketch_edge(e, frame, snap, shared) for e in edges))
+                (outer, tuple(local_edge(e, frame, snap, shared) for e in edges))
                 for outer, edges in face_wires(f)
             )
             for f in step.faces

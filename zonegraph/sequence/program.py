@@ -386,8 +386,8 @@ def _fused_common(a: Shape, b: Shape, fuzzy: float, volume_a: float, volume_b: f
     Two written files of corpus parts, each with the program's volume at every step, had every
     Boolean common with the target come back nearly empty, the cells' too, after their faces
     were unified, while their fuse with the target held what the program's own rebuild measured.
-    A fuse that drops volume would overstate the common, so a second Boolean has to agree: a cut
-    failing by the same amount as the fuse is not a failure mode that has been seen."""
+    A fuse that drops volume would overstate the common, so a second Boolean has to agree: both
+    would have to fail by the same amount for a wrong common to pass."""
     try:
         union = precise_volume(fuzzy_boolean(BRepAlgoAPI_Fuse(), a.wrapped, b.wrapped, fuzzy))
     except (ValueError, RuntimeError):
