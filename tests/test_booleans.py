@@ -3,13 +3,21 @@
 from __future__ import annotations
 
 import pytest
-from build123d import Box, Face, Pos, Shape
+from build123d import Box, Edge, Face, Pos, Shape, Solid, Vector
 from OCP.BRep import BRep_Builder
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
-from OCP.TopoDS import TopoDS_Shell, TopoDS_Solid
+from OCP.TopAbs import TopAbs_INTERNAL
+from OCP.TopoDS import TopoDS, TopoDS_Shell, TopoDS_Solid, TopoDS_Wire
 
-from zonegraph.geometry.occ import fuzzy_boolean, overlaps_merged, precise_volume, without_open_shells
+from zonegraph.geometry.occ import (
+    fuzzy_boolean,
+    overlaps_merged,
+    precise_volume,
+    without_internal_wires,
+    without_open_shells,
+)
 
 
 def _max_tolerance(shape: Shape) -> float:
@@ -52,6 +60,31 @@ def test_a_stray_open_shell_is_dropped_and_the_solid_keeps_its_volume():
     assert len(Shape.cast(kept).shells()) == 1 and Shape.cast(kept).is_valid
     assert Shape.cast(kept).volume == pytest.approx(1.0, abs=1e-12)
     assert without_open_shells(box.wrapped) is box.wrapped  # nothing to drop: the input itself
+
+
+def _with_internal_trace(face: Face) -> Face:
+    """``face`` with a line inside it as an INTERNAL wire of its own: what merging a corpus
+    part's partition faces left where chamfers met the sketch plane."""
+    builder = BRep_Builder()
+    wire = TopoDS_Wire()
+    builder.MakeWire(wire)
+    builder.Add(wire, Edge.make_line((-0.2, 0, 0), (0.2, 0, 0)).wrapped.Oriented(TopAbs_INTERNAL))
+    copy = BRepBuilderAPI_Copy(face.wrapped).Shape()
+    copy.Free(True)
+    builder.Add(copy, wire)
+    return Face(TopoDS.Face(copy))
+
+
+def test_internal_wires_are_dropped_and_the_prism_is_valid_again():
+    square = Face.make_rect(1, 1)
+    traced = _with_internal_trace(square)
+    assert len(traced.wires()) == 2
+    assert not Solid.extrude(traced, Vector(0, 0, 1)).is_valid  # an internal face inside the prism
+    clean = Face(without_internal_wires(traced.wrapped))
+    assert len(clean.wires()) == 1 and clean.area == pytest.approx(1.0)
+    prism = Solid.extrude(clean, Vector(0, 0, 1))
+    assert prism.is_valid and prism.volume == pytest.approx(1.0)
+    assert without_internal_wires(square.wrapped) is square.wrapped  # nothing to drop
 
 
 def test_overlapping_solids_are_merged_and_touching_or_apart_ones_kept():

@@ -45,6 +45,8 @@ WORK = InferConfig(budget_s=math.inf, max_expansions=2000)  # the same search on
         ("04_6to7ops/batch_010.py", "64675_42df5e14_0000"),
         # two bodies that overlap: measured against the region they fill, not their volumes summed
         ("05_8to10ops/batch_006.py", "38926_1eaf0b52_0000"),
+        # sketches merged with chamfers' internal traces as wires of their own: invalid prisms
+        ("04_6to7ops/batch_001.py", "128043_f75f37fa_0000"),
     ],
 )
 def test_a_zone_exact_program_rebuilds_exactly(batch, design_id, tmp_path):

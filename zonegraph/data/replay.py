@@ -17,6 +17,7 @@ from functools import partial
 import numpy as np
 from build123d import Compound, Face, Pos, Shape, Solid, Vector
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
@@ -377,6 +378,10 @@ def _tapered(base: Face, normal: np.ndarray, distance: float, taper: float, x: E
 # ---------------------------------------------------------------------------------- Booleans
 
 
+def _copied(shape: Shape) -> Shape:
+    return Shape.cast(BRepBuilderAPI_Copy(shape.wrapped).Shape())
+
+
 def touches(a: Shape, b: Shape, tol: float = TOUCH_TOL) -> bool:
     box_a, box_b = a.bounding_box(), b.bounding_box()
     lo_a, hi_a = np.array(tuple(box_a.min)), np.array(tuple(box_a.max))
@@ -388,7 +393,14 @@ def touches(a: Shape, b: Shape, tol: float = TOUCH_TOL) -> bool:
 
 
 def apply_operation(bodies: tuple[Solid, ...], tool: Shape, op: Operation) -> tuple[Solid, ...]:
-    """Fusion's Boolean semantics over separate bodies."""
+    """Fusion's Boolean semantics over separate bodies.
+
+    The Booleans take a copy of the tool: build123d's grow their operands' tolerances in place,
+    and the tool goes on into the cells of later steps (:func:`cells_bodies`). A written
+    program's join gave an invalid solid, and the cells of its tools, valid when fresh, failed at
+    every fuzzy value after the joins had run on them. The bodies are not copied: they are this
+    step's own, and a copy changed which common a later IoU could measure."""
+    tool = _copied(tool)
     tool_solids = tuple(tool.solids())
     if op is Operation.NEW_BODY:
         return bodies + tool_solids

@@ -23,7 +23,7 @@ from OCP.collections import (
 )
 from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
 from OCP.GProp import GProp_GProps
-from OCP.TopAbs import TopAbs_ShapeEnum, TopAbs_SHELL, TopAbs_SOLID
+from OCP.TopAbs import TopAbs_INTERNAL, TopAbs_ShapeEnum, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Iterator, TopoDS_Shape, TopoDS_Solid
@@ -243,13 +243,37 @@ def _union(solids: list[TopoDS_Shape]) -> TopoDS_Shape:
     return shape
 
 
-def _closed_shells_only(solid: TopoDS_Shape) -> TopoDS_Shape:
-    shells = []
-    it = TopoDS_Iterator(solid)
+def without_internal_wires(face: TopoDS_Shape) -> TopoDS_Shape:
+    """``face`` without its wires whose every edge is INTERNAL (``face`` itself when it has none).
+
+    A sketch merged from partition faces can keep, as wires of their own, the internal traces
+    other surfaces left on it (a corpus part's chamfers: seven such wires beside 17 holes); its
+    prism then holds internal faces, the checker rejects it, and every Boolean with it failed
+    (a zone-exact program rebuilt to IoU 0). They bound no area, so dropping them changes no
+    region."""
+    children = _children(face)
+    kept = [w for w in children if not (w.ShapeType() == TopAbs_WIRE and _all_internal(w))]
+    if len(kept) == len(children):
+        return face
+    return TopoDS.Face(_filled(face.EmptyCopied(), kept))
+
+
+def _children(shape: TopoDS_Shape) -> list[TopoDS_Shape]:
+    out = []
+    it = TopoDS_Iterator(shape)
     while it.More():
-        if it.Value().ShapeType() == TopAbs_SHELL:
-            shells.append(it.Value())
+        out.append(it.Value())
         it.Next()
+    return out
+
+
+def _all_internal(wire: TopoDS_Shape) -> bool:
+    edges = _children(wire)
+    return bool(edges) and all(e.Orientation() == TopAbs_INTERNAL for e in edges)
+
+
+def _closed_shells_only(solid: TopoDS_Shape) -> TopoDS_Shape:
+    shells = [s for s in _children(solid) if s.ShapeType() == TopAbs_SHELL]
     closed = [s for s in shells if BRep_Tool.IsClosed_s(s)]
     if len(closed) in (0, len(shells)):
         return solid

@@ -30,6 +30,7 @@ from zonegraph.geometry.occ import (
     fuzzy_boolean,
     make_compound,
     precise_volume,
+    without_internal_wires,
     without_open_shells,
 )
 from zonegraph.geometry.shapes import possible_volume, volume_of
@@ -97,10 +98,11 @@ def partition_faces(graph: ZoneGraph) -> list:
 
 
 def merge_faces(faces: list) -> list[Face]:
-    """Coplanar faces sharing edges merged into as few clean faces as possible."""
+    """Coplanar faces sharing edges merged into as few clean faces as possible, without the
+    internal wires a merge can leave (:func:`~zonegraph.geometry.occ.without_internal_wires`)."""
     shapes = [Shape.cast(f) for f in faces]
     merged = shapes[0].fuse(*shapes[1:]) if len(shapes) > 1 else shapes[0]
-    return list(merged.clean().faces())
+    return [Face(without_internal_wires(f.wrapped)) for f in merged.clean().faces()]
 
 
 def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGenerator) -> list[ProgramStep]:
