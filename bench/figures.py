@@ -4,6 +4,7 @@
         [--commit SHA] [--out docs/figures]
     python -m bench.figures fusion-diff NAME RESULTS.json --command "..." [--commit SHA]
     python -m bench.figures conversion NAME data/details/conversion.json --command "..."
+    python -m bench.figures coverage NAME data/gt/designs.parquet --command "dvc repro ground_truth"
     python -m bench.figures fuzz NAME DIR/rows.json --command "python -m bench.fuzz_bench ..."
     python -m bench.figures verify NAME DIR/results.json --command "python -m bench.verify_bench ..."
     python -m bench.figures fault NAME DIR/results.json --command "python -m bench.fault_bench ..."
@@ -27,7 +28,9 @@ from datetime import date
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
+from eval.coverage import CATEGORIES, LABELS, coverage_table
 from zonegraph.status import Status
 
 FIGURES = Path("docs/figures")
@@ -85,6 +88,24 @@ def conversion_figure(details: dict) -> dict:
         "converted": sum(g["converted"] for g in by_folder.values()),
         "failed_by_status": {k: v for k, v in details["by_status"].items() if k != Status.OK},
     }
+
+
+def coverage_figure(designs: pd.DataFrame) -> dict:
+    """The coverage categories by timeline folder of every variant (graph, proposal level) that
+    the ``ground_truth`` stage measured, from its ``data/gt/designs.parquet``; a variant the stage
+    left out (``full_graph: false``) has no status and no table."""
+    variants = {}
+    for graph in ("simplified", "full"):
+        measured = f"{graph}_status" in designs and designs[f"{graph}_status"].notna().any()
+        for level in (1, 3):
+            if not measured or f"{graph}_captured_l{level}" not in designs:
+                continue
+            table = coverage_table(designs, graph, level)
+            folders = [f for f in table.columns if f != "all"]
+            variants[f"{graph} graph, level {level}"] = {
+                c: {f: int(table.loc[c, f]) for f in folders} for c in CATEGORIES
+            }
+    return {"variants": variants, "labels": LABELS, "designs": len(designs)}
 
 
 def fuzz_figure(rows: list[dict]) -> dict:
@@ -229,6 +250,7 @@ FIGURES_OF = {
     "fault": fault_figure,
     "corpus": corpus_figure,
     "conversion": conversion_figure,
+    "coverage": coverage_figure,
     "fuzz": fuzz_figure,
     "verify": verify_figure,
 }
@@ -266,7 +288,7 @@ def main() -> None:
     ap.add_argument("--measured", default=date.today().isoformat(), help="the day it ran (default: today)")
     ap.add_argument("--out", type=Path, default=FIGURES)
     args = ap.parse_args()
-    data = json.loads(args.results.read_text())
+    data = pd.read_parquet(args.results) if args.kind == "coverage" else json.loads(args.results.read_text())
     figure = FIGURES_OF[args.kind](data) if args.kind in FIGURES_OF else data
     commit = args.commit or head_commit()
     path = write_figure(args.kind, args.name, figure, args.command, commit, args.measured, args.out)

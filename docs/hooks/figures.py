@@ -115,6 +115,25 @@ def conversion(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def coverage(records: list[dict]) -> str:
+    """The coverage categories of every measured variant: share of all designs, then of each
+    timeline folder, with the counts of designs per folder as the last row."""
+    (r,) = records
+    f = r["figure"]
+    out = []
+    for name, table in f["variants"].items():
+        folders = sorted({k for counts in table.values() for k in counts})
+        totals = {k: sum(counts.get(k, 0) for counts in table.values()) for k in folders}
+        n = sum(totals.values())
+        out += [f"**{name}**", "", _row("category", ["all", *folders]), "|---" * (len(folders) + 2) + "|"]
+        for category, counts in table.items():
+            total = sum(counts.values())
+            cells = [f"{counts.get(k, 0) / totals[k]:.0%}" if totals[k] else "-" for k in folders]
+            out.append(_row(f["labels"][category], [f"{total:,} ({total / n:.1%})" if n else "-", *cells]))
+        out += [_row("designs", [f"{n:,}", *(f"{totals[k]:,}" for k in folders)]), ""]
+    return "\n".join(out) + "\nMeasured by:\n\n" + _sources(records)
+
+
 def _outcome_order(outcome: str) -> tuple[int, str]:
     """The contract's outcomes first, then the violations (a figure file sorts its keys)."""
     kept = ("success", "user_error", "timeout")
@@ -268,6 +287,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "corpus-exact": corpus_exact,
     "fusion-diff": fusion_diff,
     "conversion": conversion,
+    "coverage": coverage,
     "fuzz": fuzz,
 }
 

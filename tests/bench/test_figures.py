@@ -5,10 +5,11 @@ import json
 import re
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from bench.fault_bench import Tally, write_results
-from bench.figures import conversion_figure, corpus_figure, fault_figure, fuzz_figure
+from bench.figures import conversion_figure, corpus_figure, coverage_figure, fault_figure, fuzz_figure
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -154,3 +155,35 @@ def test_build_search_and_replay_figures_come_from_the_benches_rows():
     assert f"| synthetic, simplified | {group['built']}/3 (" in hook.build([{**record, "figure": built}])
     assert "| synthetic (3 of 3 searched, heuristic, 2 s) |" in hook.search([{**record, "figure": searched}])
     assert f"| synthetic (3) | {r['steps']} |" in hook.replay([{**record, "figure": replayed}])
+
+
+def test_the_coverage_figure_counts_each_measured_variant_by_folder():
+    ok = {"convert_status": "ok", "replay_status": "ok", "graph_status": "ok", "simplified_status": "ok"}
+    rows = [
+        {**ok, "folder": "01", "simplified_captured_l1": True, "operations": "new_body"},
+        {
+            **ok,
+            "folder": "01",
+            "simplified_captured_l1": False,
+            "simplified_search_exact": True,
+            "simplified_reaches_target": True,
+            "operations": "new_body,cut",
+        },
+        {
+            **ok,
+            "folder": "02",
+            "graph_status": "fuse_failed",
+            "simplified_status": None,
+            "operations": "new_body",
+        },
+    ]
+    designs = pd.DataFrame(rows).assign(full_status=None, full_captured_l1=None)
+    f = coverage_figure(designs)
+    assert list(f["variants"]) == ["simplified graph, level 1"] and f["designs"] == 3
+    table = f["variants"]["simplified graph, level 1"]
+    assert table["gt_captured"] == {"01": 1, "02": 0} and table["other_sequence"] == {"01": 1, "02": 0}
+    assert table["zone_graph_failed"] == {"01": 0, "02": 1}
+    record = {"name": "n", "command": "c", "commit": "abc1234", "measured": "today", "figure": f}
+    text = _hook().coverage([record])
+    assert "| reconstructable with the GT sequence | 1 (33.3%) | 50% | 0% |" in text
+    assert "| designs | 3 | 2 | 1 |" in text
