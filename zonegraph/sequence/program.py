@@ -286,12 +286,15 @@ def _cleaned(shape: Shape) -> Shape:
     """``shape`` with its same-domain faces merged, as build123d's ``clean`` does, unless the
     merge breaks a valid shape: seen on a corpus part whose valid union of two prisms came back
     invalid from it, so every alternative and the cells failed with it and a program exact on
-    zones was reported ``rebuild_failed``. The merged faces are cosmetic. ``clean`` works in
-    place, hence the copy. Stray open shells are dropped
+    zones was reported ``rebuild_failed``. The merged faces are cosmetic. ``clean`` changes the
+    sub-shapes it shares with its input, so it runs on a deep copy: on a new ``Shape`` of the
+    same ``TopoDS_Shape`` it broke a valid union of a notched block and a cylinder filling the
+    notch (124497_5c00f42d_0012), whose raw result then failed the check too, and the program
+    exact on zones rebuilt to B-rep IoU 0. Stray open shells are dropped
     (:func:`~zonegraph.geometry.occ.without_open_shells`)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "Unable to clean": the raw shape is kept, as below
-        cleaned = Shape.cast(shape.wrapped).clean()
+        cleaned = _copy(shape).clean()
     chosen = cleaned if cleaned.is_valid or not shape.is_valid else shape
     return Shape.cast(without_open_shells(chosen.wrapped))
 
