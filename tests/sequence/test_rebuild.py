@@ -47,6 +47,9 @@ WORK = InferConfig(budget_s=math.inf, max_expansions=2000)  # the same search on
         ("05_8to10ops/batch_006.py", "38926_1eaf0b52_0000"),
         # sketches merged with chamfers' internal traces as wires of their own: invalid prisms
         ("04_6to7ops/batch_001.py", "128043_f75f37fa_0000"),
+        # a notched block and a cylinder filling the notch: merging the union's faces in place
+        # broke the raw union it shared sub-shapes with, and the rebuild measured IoU 0
+        ("04_6to7ops/batch_001.py", "124497_5c00f42d_0012"),
     ],
 )
 def test_a_zone_exact_program_rebuilds_exactly(batch, design_id, tmp_path):

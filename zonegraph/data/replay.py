@@ -399,7 +399,9 @@ def apply_operation(bodies: tuple[Solid, ...], tool: Shape, op: Operation) -> tu
     and the tool goes on into the cells of later steps (:func:`cells_bodies`). A written
     program's join gave an invalid solid, and the cells of its tools, valid when fresh, failed at
     every fuzzy value after the joins had run on them. The bodies are not copied: they are this
-    step's own, and a copy changed which common a later IoU could measure."""
+    step's own, and a copy changed which common a later IoU could measure. For the same reason
+    the results are cleaned in place, not as :func:`~zonegraph.geometry.occ.unified` does: on
+    copies, the written JSON of 41125_711db4bf_0002 measured 0.9984 instead of exact."""
     tool = _copied(tool)
     tool_solids = tuple(tool.solids())
     if op is Operation.NEW_BODY:

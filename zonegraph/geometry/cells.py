@@ -10,20 +10,18 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator, Sequence
 
 from OCP.BOPAlgo import BOPAlgo_CellsBuilder
-from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.BRepCheck import BRepCheck_Analyzer
-from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 from OCP.TopAbs import TopAbs_SOLID
 from OCP.TopoDS import TopoDS_Shape
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
-from zonegraph.errors import is_kernel_error
 from zonegraph.geometry.occ import (
     make_compound,
     shape_index,
     shape_list,
     shapes_of,
     sub_shapes,
+    unified,
     without_open_shells,
 )
 
@@ -34,7 +32,7 @@ def fuse_zones(zones: Sequence[TopoDS_Shape], selected: Sequence[int]) -> TopoDS
     for i in selected:
         builder.AddToResult(shape_list([zones[i]]), shape_list([]), 1, False)
     builder.RemoveInternalBoundaries()
-    return _unified(builder.Shape())
+    return unified(builder.Shape())
 
 
 # Fuzzy values of a Boolean or a cells evaluation, as shares of the operands' bounding-box
@@ -76,13 +74,8 @@ def select_cells(
         builder.AddToResult(shape_list(take), shape_list(avoid), 1, False)
     builder.RemoveInternalBoundaries()
     raw = without_open_shells(builder.Shape())
-    try:
-        unified = without_open_shells(_unified(BRepBuilderAPI_Copy(raw).Shape()))
-    except Exception as exc:  # "Courbes non jointives" on a corpus part whose raw cells were valid
-        if not is_kernel_error(exc):
-            raise
-        return raw
-    return unified if _valid(unified) or not _valid(raw) else raw
+    merged = without_open_shells(unified(raw))  # raw itself where the unifier raises
+    return merged if _valid(merged) or not _valid(raw) else raw
 
 
 def _cells(arguments: Sequence[TopoDS_Shape], fuzzy: float) -> BOPAlgo_CellsBuilder:
@@ -111,12 +104,6 @@ def _cell_owners(builder: BOPAlgo_CellsBuilder, arguments: Sequence[TopoDS_Shape
                 if k > 0:
                     owners[k - 1].add(i)
     return [frozenset(o) for o in owners]
-
-
-def _unified(shape: TopoDS_Shape) -> TopoDS_Shape:
-    unify = ShapeUpgrade_UnifySameDomain(shape, True, True, True)
-    unify.Build()
-    return unify.Shape()
 
 
 def _valid(shape: TopoDS_Shape) -> bool:

@@ -23,12 +23,14 @@ from OCP.collections import (
 )
 from OCP.gp import gp_Dir, gp_Pnt, gp_Vec
 from OCP.GProp import GProp_GProps
+from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 from OCP.TopAbs import TopAbs_INTERNAL, TopAbs_ShapeEnum, TopAbs_SHELL, TopAbs_SOLID, TopAbs_WIRE
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Iterator, TopoDS_Shape, TopoDS_Solid
 
 import zonegraph.geometry.kernel  # noqa: F401 - OCCT's thread pool held before any Boolean
+from zonegraph.errors import is_kernel_error
 
 _Container = TypeVar("_Container", TopoDS_Compound, TopoDS_Solid)
 
@@ -174,6 +176,27 @@ def _filled(container: _Container, parts: Iterable[TopoDS_Shape]) -> _Container:
     for part in parts:
         builder.Add(container, part)
     return container
+
+
+def unified(shape: TopoDS_Shape) -> TopoDS_Shape:
+    """A deep copy of ``shape`` with its same-domain faces and edges merged (what build123d's
+    ``clean`` does), or ``shape`` itself where the unifier raises.
+
+    The unifier changes in place the sub-shapes it works on, and a Boolean's or a cells
+    builder's result shares its unchanged sub-shapes with the operands. Cleaning a result in
+    place therefore changes the operands that the caller keeps (the zone graph's partition faces
+    and zones, the bodies of a replay, a raw union kept as the fallback): a valid union of a
+    notched block and a cylinder filling the notch was broken together with its cleaned form,
+    and a program exact on zones rebuilt to B-rep IoU 0. On a copy, nothing else changes."""
+    unify = ShapeUpgrade_UnifySameDomain(BRepBuilderAPI_Copy(shape).Shape(), True, True, True)
+    unify.AllowInternalEdges(False)
+    try:
+        unify.Build()
+    except Exception as exc:  # OCP raises each OCCT failure as a plain Exception
+        if not is_kernel_error(exc):
+            raise
+        return shape
+    return unify.Shape()
 
 
 def without_open_shells(shape: TopoDS_Shape) -> TopoDS_Shape:

@@ -8,7 +8,6 @@ and compared with the target by OpenCASCADE Booleans: that B-rep IoU is the hone
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -30,6 +29,7 @@ from zonegraph.geometry.occ import (
     fuzzy_boolean,
     make_compound,
     precise_volume,
+    unified,
     without_internal_wires,
     without_open_shells,
 )
@@ -56,7 +56,7 @@ class ProgramStep:
         face's normal is an inside-out solid that the checker rejects and Booleans mishandle."""
         d = Vector(*self.direction) * self.distance
         solids = [_prism(f, d) for f in self.faces]
-        return solids[0] if len(solids) == 1 else solids[0].fuse(*solids[1:]).clean()
+        return solids[0] if len(solids) == 1 else Shape.cast(unified(solids[0].fuse(*solids[1:]).wrapped))
 
 
 def _facing(face: Face, d: Vector) -> Face:
@@ -102,7 +102,7 @@ def merge_faces(faces: list) -> list[Face]:
     internal wires a merge can leave (:func:`~zonegraph.geometry.occ.without_internal_wires`)."""
     shapes = [Shape.cast(f) for f in faces]
     merged = shapes[0].fuse(*shapes[1:]) if len(shapes) > 1 else shapes[0]
-    return [Face(without_internal_wires(f.wrapped)) for f in merged.clean().faces()]
+    return [Face(without_internal_wires(f.wrapped)) for f in Shape.cast(unified(merged.wrapped)).faces()]
 
 
 def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGenerator) -> list[ProgramStep]:
@@ -283,18 +283,13 @@ def _boolean(shape: Shape, tool: Shape, op: Op, fuzzy: float) -> Shape | None:
 
 
 def _cleaned(shape: Shape) -> Shape:
-    """``shape`` with its same-domain faces merged, as build123d's ``clean`` does, unless the
-    merge breaks a valid shape: seen on a corpus part whose valid union of two prisms came back
-    invalid from it, so every alternative and the cells failed with it and a program exact on
-    zones was reported ``rebuild_failed``. The merged faces are cosmetic. ``clean`` changes the
-    sub-shapes it shares with its input, so it runs on a deep copy: on a new ``Shape`` of the
-    same ``TopoDS_Shape`` it broke a valid union of a notched block and a cylinder filling the
-    notch (124497_5c00f42d_0012), whose raw result then failed the check too, and the program
-    exact on zones rebuilt to B-rep IoU 0. Stray open shells are dropped
+    """``shape`` with its same-domain faces merged (:func:`~zonegraph.geometry.occ.unified`, on a
+    copy, so the raw shape stays as it was), unless the merge breaks a valid shape: seen on a
+    corpus part whose valid union of two prisms came back invalid from it, so every alternative
+    and the cells failed with it and a program exact on zones was reported ``rebuild_failed``.
+    The merged faces are cosmetic. Stray open shells are dropped
     (:func:`~zonegraph.geometry.occ.without_open_shells`)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # "Unable to clean": the raw shape is kept, as below
-        cleaned = _copy(shape).clean()
+    cleaned = Shape.cast(unified(shape.wrapped))
     chosen = cleaned if cleaned.is_valid or not shape.is_valid else shape
     return Shape.cast(without_open_shells(chosen.wrapped))
 
