@@ -92,17 +92,25 @@ def main() -> None:
     steps = [dict(step, design_id=r["design_id"]) for r in records for step in r.get("steps", [])]
     args.out.mkdir(parents=True, exist_ok=True)
     pd.DataFrame(steps).to_parquet(args.out / "steps.parquet", index=False)
-    results = records_frame([{k: v for k, v in r.items() if k != "steps"} for r in records])
-    failed = results["status"] != Status.OK  # the whole job timed out or crashed
-    for graph in ("simplified", "full"):
-        column = f"{graph}_status"
-        if column not in results:
-            results[column] = None
-        results.loc[failed, column] = results.loc[failed, "status"]
-    results = results.drop(columns=["status", "reason"]).rename(columns={"seconds": "gt_seconds"})
+    results = graph_results(records_frame([{k: v for k, v in r.items() if k != "steps"} for r in records]))
     designs = table.merge(results, on="design_id", how="left")
     designs.to_parquet(args.out / "designs.parquet", index=False)
     write_coverage(designs, levels, args.out, args.plot, args.metrics, args.details)
+
+
+def graph_results(results: pd.DataFrame) -> pd.DataFrame:
+    """The records' rows with a failed job's status and reason (it timed out, crashed, or its
+    graph would not load) as each graph's, so a design's row says why it has no ground truth."""
+    failed = results["status"] != Status.OK
+    results = results.copy()
+    for graph in ("simplified", "full"):
+        for field in ("status", "reason"):
+            column = f"{graph}_{field}"
+            if column not in results:
+                results[column] = None
+            results[column] = results[column].astype(object)
+            results.loc[failed, column] = results.loc[failed, field]
+    return results.drop(columns=["status", "reason"]).rename(columns={"seconds": "gt_seconds"})
 
 
 def write_coverage(
