@@ -50,6 +50,9 @@ def test_round_off_below_zero_loads_and_a_negative_volume_does_not(tmp_path):
     graph = build_zone_graph(Box(2, 1, 1) - Box(1, 1, 1), samples=0)
     graph.zone_volume[0], graph.face_area[0] = -5.5e-16, -1.9e-11  # as the fuse measures slivers
     assert load_zone_graph(save_zone_graph(graph, tmp_path / "g")).zone_volume[0] == -5.5e-16
+    sliver = -1.0e-5 * graph.box_volume  # a 2,589-zone corpus part's
+    graph.zone_volume[0] = sliver
+    assert load_zone_graph(save_zone_graph(graph, tmp_path / "s")).zone_volume[0] == sliver
     graph.zone_volume[0] = -1e-3
     with pytest.raises(InputError, match="negative zone volume"):
         load_zone_graph(save_zone_graph(graph, tmp_path / "h"))
