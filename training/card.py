@@ -25,6 +25,21 @@ DATA = (
 )
 
 
+def architecture(model: dict) -> str:
+    """The network in one sentence, from its configuration (paper sec. 4.2 and what differs)."""
+    zones = (
+        "a PointNet over each zone's surface samples beside its flags"
+        if model.get("use_points", True)
+        else "each zone's flags (no point encoder)"
+    )
+    features = model.get("features") or ()
+    extra = f", with {len(features)} proposal features beside the pooled graph" if features else ""
+    return (
+        f"{zones}, {model.get('rounds', 3)} rounds of message passing over zone adjacency "
+        f"({model.get('fusion', 'late')} fusion), a max pool and an MLP{extra}."
+    )
+
+
 def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str = "") -> str:
     """Markdown describing ``checkpoint`` (loaded from ``path``)."""
     train, model, metrics = checkpoint["train"], checkpoint["model"], checkpoint["metrics"]
@@ -32,9 +47,9 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
     lines = [
         f"# Model card: `{path.name}`",
         "",
-        "The proposal scorer of the network guide (`zonegraph infer PART --guide net`): a PointNet over",
-        "zone surface samples, message passing over zone adjacency, a max pool and an MLP (paper",
-        f"sec. 4.2). Size: {path.stat().st_size / 1e6:.2f} MB, "
+        "The proposal scorer of the network guide (`zonegraph infer PART --guide net`):",
+        architecture(model),
+        f"Size: {path.stat().st_size / 1e6:.2f} MB, "
         f"{sum(v.numel() for v in checkpoint['state_dict'].values()):,} parameters.",
         "",
         "## Data",
