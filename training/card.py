@@ -1,7 +1,7 @@
 """The model card of a checkpoint: what it was trained on, how, and how well it ranks.
 
     python -m training.card models/scorer.pt --out zonegraph/network/checkpoints/MODEL_CARD.md
-        [--test-ranks eval_out/rank.json] [--note "free text"]
+        [--test-ranks eval_out/rank.json] [--note "free text"] [--top-m M] [--blend B]
 
 Everything is read from the checkpoint (:func:`training.train.save_checkpoint` stores the model
 and training configuration, the best epoch's metrics and the provenance: data version, git commit,
@@ -86,6 +86,12 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
             "- test split relative GT rank: "
             + ", ".join(f"{k} {v:.4f}" if isinstance(v, float) else f"{k} {v}" for k, v in test_ranks.items())
         )
+    if checkpoint.get("search"):
+        knobs = ", ".join(f"{k} {v}" for k, v in checkpoint["search"].items())
+        lines.append(
+            f"- search defaults stored with the weights: {knobs} (top_m: only the heuristic's top M "
+            "proposals of a state are scored, the rest keep the heuristic's order below them)"
+        )
     lines += [
         "",
         "## Provenance",
@@ -105,8 +111,18 @@ def main() -> None:
     parser.add_argument("--out", type=Path, required=True)
     parser.add_argument("--test-ranks", type=Path, default=None, help="JSON of guide -> rank")
     parser.add_argument("--note", default="")
+    parser.add_argument(
+        "--top-m", type=int, default=None, help="store: the guide scores only the heuristic's top M"
+    )
+    parser.add_argument(
+        "--blend", type=float, default=None, help="store: the heuristic's weight in the score"
+    )
     args = parser.parse_args()
     checkpoint = torch.load(args.checkpoint, map_location="cpu", weights_only=True)
+    search = {k: v for k, v in (("top_m", args.top_m), ("blend", args.blend)) if v is not None}
+    if search:  # the guide's defaults (NetworkRanker reads them), kept with the weights they suit
+        checkpoint["search"] = {**checkpoint.get("search", {}), **search}
+        torch.save(checkpoint, args.checkpoint)
     ranks = json.loads(args.test_ranks.read_text()) if args.test_ranks else None
     args.out.write_text(card(checkpoint, args.checkpoint, ranks, args.note))
     print(f"model card -> {args.out}")
