@@ -56,7 +56,7 @@ class ProgramStep:
         face's normal is an inside-out solid that the checker rejects and Booleans mishandle."""
         d = Vector(*self.direction) * self.distance
         solids = [_prism(f, d) for f in self.faces]
-        return solids[0] if len(solids) == 1 else Shape.cast(unified(solids[0].fuse(*solids[1:]).wrapped))
+        return solids[0] if len(solids) == 1 else _unified(solids[0].fuse(*solids[1:]))
 
 
 def _facing(face: Face, d: Vector) -> Face:
@@ -102,7 +102,7 @@ def merge_faces(faces: list) -> list[Face]:
     internal wires a merge can leave (:func:`~zonegraph.geometry.occ.without_internal_wires`)."""
     shapes = [Shape.cast(f) for f in faces]
     merged = shapes[0].fuse(*shapes[1:]) if len(shapes) > 1 else shapes[0]
-    return [Face(without_internal_wires(f.wrapped)) for f in Shape.cast(unified(merged.wrapped)).faces()]
+    return [Face(without_internal_wires(f.wrapped)) for f in _unified(merged).faces()]
 
 
 def build_program(graph: ZoneGraph, steps: list[Proposal], generator: ProposalGenerator) -> list[ProgramStep]:
@@ -289,7 +289,7 @@ def _cleaned(shape: Shape) -> Shape:
     and the cells failed with it and a program exact on zones was reported ``rebuild_failed``.
     The merged faces are cosmetic. Stray open shells are dropped
     (:func:`~zonegraph.geometry.occ.without_open_shells`)."""
-    cleaned = Shape.cast(unified(shape.wrapped))
+    cleaned = _unified(shape)
     chosen = cleaned if cleaned.is_valid or not shape.is_valid else shape
     return Shape.cast(without_open_shells(chosen.wrapped))
 
@@ -405,6 +405,10 @@ def _fused_common(a: Shape, b: Shape, fuzzy: float, volume_a: float, volume_b: f
             if abs(cut - left) <= tol:
                 return max(inter, 0.0)
     return 0.0
+
+
+def _unified(shape: Shape) -> Shape:
+    return Shape.cast(unified(shape.wrapped))
 
 
 def _copy(shape: Shape) -> Shape:
