@@ -9,6 +9,7 @@
     python -m bench.figures verify NAME DIR/results.json --command "python -m bench.verify_bench ..."
     python -m bench.figures fault NAME DIR/results.json --command "python -m bench.fault_bench ..."
     python -m bench.figures build|search|replay NAME DIR/results.json --command "python -m bench..."
+    python -m bench.figures guide-cost NAME DIR/guide_cost.json --command "python -m bench.guide_cost..."
 
 A results page never carries a number typed by hand: a benchmark's ``results.json`` (its per-design
 rows, or its summary) is reduced here to a small figure file, ``docs/figures/NAME.json``, holding
@@ -243,6 +244,52 @@ def fault_figure(tallies: dict[str, dict]) -> dict:
     }
 
 
+def _median_ratio(times: pd.DataFrame, guide: str, reference: str, seed: int = 0) -> dict:
+    """Median time to exact of ``guide`` over ``reference``'s on the designs both solved, with a
+    seeded 90% bootstrap interval over those designs."""
+    pair = times[[guide, reference]].dropna().to_numpy()
+    if len(pair) == 0:
+        return {"designs": 0, "ratio": None, "ci": None}
+
+    def ratio(rows: np.ndarray) -> float:
+        ref = float(np.median(rows[:, 1]))
+        return float(np.median(rows[:, 0])) / ref if ref > 0 else float("nan")
+
+    draws = np.random.default_rng(seed).integers(0, len(pair), (2000, len(pair)))
+    boot = np.array([ratio(pair[d]) for d in draws])
+    low, high = np.nanpercentile(boot, [5, 95])
+    return {"designs": len(pair), "ratio": round(ratio(pair), 3), "ci": [round(float(low), 3), round(float(high), 3)]}
+
+
+def _median(values: pd.Series, digits: int) -> float | None:
+    return round(float(values.median()), digits) if len(values) else None
+
+
+def guide_cost_figure(results: dict, reference: str = "heuristic") -> dict:
+    """The guide cost benchmark by budget and guide: exact (all designs and GT >= 3), medians on
+    the designs every guide solved, and each guide's median time to exact over the reference's
+    on the designs both solved."""
+    rows = pd.DataFrame(results["rows"])
+    budgets = {}
+    for budget, at in rows.groupby("budget"):
+        times = at.pivot(index="design_id", columns="guide", values="time_to_exact_s")
+        common = set(at.groupby("design_id")["exact"].all().loc[lambda s: s].index)
+        guides = {}
+        for guide, group in at.groupby("guide", sort=False):
+            long, both = group[group["gt_steps"] >= 3], group[group["design_id"].isin(common)]
+            guides[str(guide)] = {
+                "exact": int(group["exact"].sum()),
+                "designs": len(group),
+                "exact_gt3": int(long["exact"].sum()),
+                "designs_gt3": len(long),
+                "median_time_to_exact_s": _median(both["time_to_exact_s"], 5),
+                "median_expansions": _median(both["expansions"], 1),
+                "time_ratio": _median_ratio(times, str(guide), reference) if guide != reference else None,
+            }
+        budgets[f"{budget:g}"] = {"common": len(common), "guides": guides}
+    return {"reference": reference, "budgets": budgets}
+
+
 FIGURES_OF = {
     "build": build_figure,
     "search": search_figure,
@@ -253,6 +300,7 @@ FIGURES_OF = {
     "coverage": coverage_figure,
     "fuzz": fuzz_figure,
     "verify": verify_figure,
+    "guide-cost": guide_cost_figure,
 }
 
 

@@ -96,10 +96,11 @@ def test_only_the_network_layer_imports_torch_and_nothing_imports_it_eagerly():
     assert not bad, "torch outside zonegraph.network:\n" + "\n".join(sorted(bad))
 
 
-def test_the_package_and_the_cli_help_load_no_torch():
+def test_the_package_the_cli_help_and_the_shipped_network_guide_load_no_torch():
     code = (
         "import sys, contextlib, io, zonegraph, zonegraph.network, zonegraph.plugins, zonegraph.cli\n"
         "zonegraph.plugins.available_guides()\n"
+        "import zonegraph.sequence.rankers as r; r.make_ranker('net')\n"
         "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
         "    zonegraph.cli.main(['infer', '--help'])\n"
         "print(sorted(m for m in ('torch', 'torch_geometric') if m in sys.modules))"

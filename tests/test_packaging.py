@@ -1,5 +1,6 @@
 """What ``pip install`` gives a user: one top-level name, the shipped checkpoint, and a core-only
-install (no torch) that runs the heuristic guide and turns ``--guide net`` into one line.
+install (no torch) that runs every guide, the network's shipped weights folded to numpy, and
+turns a PyTorch checkpoint into one line naming the extra it needs.
 
 The core-only venv is an honest install: a fresh venv without system site packages, the built
 wheel and its core dependencies installed by pip from the configured indexes (a couple of
@@ -65,39 +66,45 @@ def test_the_wheel_installs_one_top_level_name_and_ships_the_checkpoint(wheel):
         assert archive.read(top_level).decode().split() == ["zonegraph"]
     assert {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")} == {"zonegraph"}
     assert "zonegraph/network/checkpoints/scorer.pt" in names
+    assert "zonegraph/network/checkpoints/scorer.npz" in names
     assert "zonegraph/network/checkpoints/MODEL_CARD.md" in names
     assert "zonegraph/network/ranker.py" in names
 
 
-def test_a_core_install_runs_the_heuristic_guide_and_names_the_extra_for_net(
+def test_a_core_install_runs_every_guide_and_names_the_extra_for_a_pytorch_checkpoint(
     core_venv, samples_dir, tmp_path
 ):
     python, zonegraph = str(core_venv / "python"), str(core_venv / "zonegraph")
     assert subprocess.run([python, "-c", TORCH_FREE], capture_output=True, text=True).stdout.split() == ["[]"]
     guides = "import zonegraph.plugins as p; print(p.available_guides())"
     listed = subprocess.run([python, "-c", guides], capture_output=True, text=True, check=True, cwd=tmp_path)
-    assert listed.stdout.strip() == "['heuristic', 'random']"
+    assert listed.stdout.strip() == "['heuristic', 'random', 'net']"
     part = samples_dir / "Couch.step"
-    heuristic = [zonegraph, "infer", str(part), "--out", str(tmp_path / "h"), "--budget", "5"]
-    proc = subprocess.run(heuristic, capture_output=True, text=True, cwd=tmp_path)
-    assert proc.returncode == 0, proc.stderr
-    assert json.loads((tmp_path / "h" / "result.json").read_text())["status"] == "exact"
-    net = [zonegraph, "infer", str(part), "--out", str(tmp_path / "n"), "--guide", "net"]
-    proc = subprocess.run(net, capture_output=True, text=True, cwd=tmp_path)
+    for guide in ("heuristic", "net"):
+        cmd = [zonegraph, "infer", str(part), "--out", str(tmp_path / guide), "--budget", "5"]
+        cmd += ["--guide", guide]
+        proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path)
+        assert proc.returncode == 0, proc.stderr
+        assert json.loads((tmp_path / guide / "result.json").read_text())["status"] == "exact"
+    checkpoint = tmp_path / "scorer.pt"
+    checkpoint.write_bytes(b"not read: torch is missing")
+    cmd = [zonegraph, "infer", str(part), "--out", str(tmp_path / "pt"), "--model", str(checkpoint)]
+    proc = subprocess.run([*cmd, "--guide", "net"], capture_output=True, text=True, cwd=tmp_path)
     assert proc.returncode == 2
     assert proc.stderr.splitlines() == [
-        "zonegraph: error: the net guide needs torch and torch_geometric: pip install 'zonegraph[train]'"
+        f"zonegraph: error: {checkpoint}: a PyTorch checkpoint needs torch and torch_geometric: "
+        "pip install 'zonegraph[train]' (the shipped weights need neither)"
     ]
-    assert not (tmp_path / "n").exists()
+    assert not (tmp_path / "pt").exists()
 
 
 @pytest.mark.skipif(find_spec("torch") is None, reason="the network guide needs torch (the train extra)")
-def test_with_the_train_extra_net_is_listed_and_guides_infer(samples_dir, tmp_path):
-    from zonegraph.plugins import available_guides
+def test_with_the_train_extra_a_pytorch_checkpoint_guides_infer(samples_dir, tmp_path):
+    from zonegraph.network.checkpoint import SHIPPED
 
-    assert "net" in available_guides()
     part = str(samples_dir / "Couch.json")
     cmd = [sys.executable, "-m", "zonegraph.cli", "infer", part, "--out", str(tmp_path), "--guide", "net"]
+    cmd += ["--model", str(SHIPPED)]
     proc = subprocess.run([*cmd, "--budget", "10"], capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     assert json.loads((tmp_path / "result.json").read_text())["status"] == "exact"  # a box and a cut

@@ -176,7 +176,19 @@ def _guide_error(config: InferConfig) -> str | None:
         return f"--model {config.model}: the {config.guide} guide uses no model (only --guide net does)"
     if config.model is not None and not Path(config.model).is_file():
         return f"{config.model}: no such model checkpoint"
+    if config.model is not None and Path(config.model).suffix != ".npz" and not _torch_installed():
+        return (
+            f"{config.model}: a PyTorch checkpoint needs torch and torch_geometric: "
+            "pip install 'zonegraph[train]' (the shipped weights need neither)"
+        )
     return None
+
+
+def _torch_installed() -> bool:
+    """Whether torch and torch_geometric can be imported (found, not imported)."""
+    from importlib.util import find_spec
+
+    return all(find_spec(name) is not None for name in ("torch", "torch_geometric"))
 
 
 def _infer_job(config: InferConfig, timeout: float, memory_mb: int | None) -> BatchJob:

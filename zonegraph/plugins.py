@@ -1,12 +1,13 @@
 """The guides a search can rank proposals with: the built-in ones, the network guide zonegraph
-ships behind the ``train`` extra, and those other packages add through an entry-point group.
+ships, and those other packages add through an entry-point group.
 
 Kept apart from :mod:`zonegraph.sequence.rankers` and free of heavy imports, so that the CLI can
 reject an unknown guide before it loads the geometry kernel, and a batch can import a guide's
 package once in the parent instead of once in every forked child. The network guide
-(:mod:`zonegraph.network`) is named here by reference, as an entry point would be, and offered
-only where its requirements can be found: whether torch is installed is decided without
-importing it, so a core-only install lists only the guides it can run.
+(:mod:`zonegraph.network`) is named here by reference, as an entry point would be. Its shipped
+weights run folded to numpy, so it needs nothing beyond the core; a guide that needs an extra
+is offered only where its requirements can be found (decided without importing them), so an
+install lists only the guides it can run.
 """
 
 from __future__ import annotations
@@ -35,7 +36,8 @@ class ExtraGuide:
 
 
 EXTRA_GUIDES = {
-    "net": ExtraGuide("zonegraph.network.ranker:NetworkRanker", "train", ("torch", "torch_geometric")),
+    # PyTorch checkpoints (--model X.pt) need the train extra: zonegraph.cli checks those
+    "net": ExtraGuide("zonegraph.network.ranker:NetworkRanker", "train", ()),
 }
 
 
@@ -46,15 +48,14 @@ def _plugins() -> dict[str, EntryPoint]:
 
 
 def available_guides() -> list[str]:
-    """The guides this installation can run: built-in, shipped with their extra installed
-    (``net`` with torch), and registered by installed packages."""
+    """The guides this installation can run: built-in, shipped (with their extra installed, where
+    they need one), and registered by installed packages."""
     shipped = [name for name, guide in EXTRA_GUIDES.items() if guide.installed()]
     return [*BUILTIN_GUIDES, *shipped, *sorted(_plugins())]
 
 
 def missing_extra(guide: str) -> str | None:
-    """The extra a guide zonegraph ships needs and this installation lacks (``train`` for ``net``
-    without torch), or None."""
+    """The extra a guide zonegraph ships needs and this installation lacks, or None."""
     shipped = EXTRA_GUIDES.get(guide)
     return shipped.extra if shipped is not None and not shipped.installed() else None
 

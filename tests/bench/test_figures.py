@@ -9,7 +9,14 @@ import pandas as pd
 import pytest
 
 from bench.fault_bench import Tally, write_results
-from bench.figures import conversion_figure, corpus_figure, coverage_figure, fault_figure, fuzz_figure
+from bench.figures import (
+    conversion_figure,
+    corpus_figure,
+    coverage_figure,
+    fault_figure,
+    fuzz_figure,
+    guide_cost_figure,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -187,3 +194,38 @@ def test_the_coverage_figure_counts_each_measured_variant_by_folder():
     text = _hook().coverage([record])
     assert "| reconstructable with the GT sequence | 1 (33.3%) | 50% | 0% |" in text
     assert "| designs | 3 | 2 | 1 |" in text
+
+
+def test_the_guide_cost_figure_compares_each_guide_on_the_designs_both_solved():
+    def row(design, guide, exact, seconds, steps=1):
+        return {
+            "design_id": design,
+            "gt_steps": steps,
+            "guide": guide,
+            "budget": 1.0,
+            "exact": exact,
+            "time_to_exact_s": seconds if exact else None,
+            "expansions": 2,
+        }
+
+    rows = [
+        row("a", "heuristic", True, 0.002),
+        row("a", "net", True, 0.001),
+        row("b", "heuristic", True, 0.004, steps=3),
+        row("b", "net", True, 0.004, steps=3),
+        row("c", "heuristic", False, None, steps=3),
+        row("c", "net", True, 0.5, steps=3),  # net alone: outside both the common medians and the ratio
+    ]
+    figure = guide_cost_figure({"rows": rows})
+    at = figure["budgets"]["1"]
+    assert at["common"] == 2
+    net, heuristic = at["guides"]["net"], at["guides"]["heuristic"]
+    assert (net["exact"], net["exact_gt3"], net["designs_gt3"]) == (3, 2, 2)
+    assert heuristic["exact"] == 2 and heuristic["time_ratio"] is None
+    assert net["median_time_to_exact_s"] == 0.0025 and heuristic["median_time_to_exact_s"] == 0.003
+    assert net["time_ratio"]["designs"] == 2 and net["time_ratio"]["ratio"] == round(0.0025 / 0.003, 3)
+    low, high = net["time_ratio"]["ci"]
+    assert low <= net["time_ratio"]["ratio"] <= high
+    record = {"name": "run", "command": "python -m bench.guide_cost_bench", "commit": "abc1234"}
+    table = _hook().guide_cost([record | {"measured": "2026-12-05", "figure": figure}])
+    assert "| run | 1 | net | 3/3 (100.0%) | 2/2 (100.0%) | 0.0025 | 2 | 0.83 (" in table

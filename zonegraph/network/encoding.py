@@ -20,6 +20,7 @@ import torch
 from torch import Tensor
 from torch_geometric.data import Data
 
+from zonegraph.network.folded import zone_samples
 from zonegraph.sequence.features import FEATURES
 from zonegraph.zones.model import ZoneGraph
 
@@ -44,14 +45,10 @@ class Geometry:
 
 def geometry_of(graph: ZoneGraph, points_per_zone: int | None = None, seed: int = 0) -> Geometry:
     """The network's view of a zone graph, optionally keeping a seeded subset of the samples."""
-    pts = np.concatenate([graph.zone_points, graph.zone_normals], axis=2)  # (Z, S, 6)
-    if points_per_zone is not None and points_per_zone < pts.shape[1]:
-        keep = np.sort(np.random.default_rng(seed).choice(pts.shape[1], points_per_zone, replace=False))
-        pts = pts[:, keep]
     edges = graph.edges.astype(np.int64)
     both = np.concatenate([edges, edges[:, ::-1]]).T if len(edges) else np.zeros((2, 0), np.int64)
     return Geometry(
-        torch.from_numpy(np.ascontiguousarray(pts.transpose(0, 2, 1), dtype=np.float32)),
+        torch.from_numpy(zone_samples(graph, points_per_zone, seed)),
         torch.from_numpy(np.ascontiguousarray(both)),
         torch.from_numpy(graph.zone_inside.astype(bool)),
     )

@@ -1,39 +1,118 @@
 """The network guide: a trained scorer behind the search's ``Ranker`` protocol.
 
-:mod:`zonegraph.plugins` names it as the ``net`` guide by reference, and offers it only where
-torch and torch_geometric can be found, so ``zonegraph infer PART --guide net`` and
-``make_ranker("net")`` import this module (and torch) only when the guide is used. The model is
-loaded once; with late fusion a graph's zone geometry is encoded once and every state's proposals
-are scored in one batched pass, in eval mode.
+:mod:`zonegraph.plugins` names it as the ``net`` guide by reference, so ``zonegraph infer PART
+--guide net`` and ``make_ranker("net")`` import this module only when the guide is used. A
+late-fusion scorer (the default, and the shipped one) runs folded to numpy
+(:mod:`zonegraph.network.folded`): the shipped ``scorer.npz`` needs no torch at all, and a
+PyTorch checkpoint of late fusion is folded when loaded. Early and factored fusion, or a
+``device`` other than the CPU, keep the PyTorch forward (:mod:`zonegraph.network.scoring`).
+Either way a graph's zone geometry is encoded once and each state's proposals are scored in one
+batched pass, in eval mode.
 
-Scoring counts inside the search's budget, so two knobs trade the network's cost against the
+Scoring counts inside the search's budget, so three knobs trade the network's cost against the
 heuristic's: ``top_m`` scores only the heuristic's best M proposals of a state with the network
 (the rest follow, in the heuristic's order, below every scored one), and ``blend`` mixes the
 heuristic's score into the network's (``(1 - blend) * net + blend * heuristic``). A checkpoint
-may carry its own defaults for both (its ``search`` entry); the arguments override them.
+may carry its own defaults for both (its ``search`` entry); the arguments override them. And a
+proposal that completes the target (its canvas after the step agrees with the target on every
+zone) goes first unscored: it ends the search, whatever a scorer would say of it.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
-import torch
 
-from zonegraph.network.checkpoint import SHIPPED, read_checkpoint, scorer_from
-from zonegraph.network.encoding import Geometry, geometry_of
-from zonegraph.network.model import ProposalScorer
-from zonegraph.network.scoring import score_state
+from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State, zone_samples
 from zonegraph.sequence.features import proposal_features, target_surfaces
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.sequence.rankers import HeuristicRanker
 from zonegraph.zones.model import ZoneGraph
 
 UNSCORED = -3.0  # below any network score (a probability) minus the heuristic's (< 2)
+COMPLETES = 2.0  # above any network score, with the heuristic's (< 2) added
+
+
+class StateScorer(Protocol):
+    """P(positive) of one state's proposals; keeps what it encodes per graph."""
+
+    columns: tuple[int, ...]  # the proposal features it reads (none: it needs none computed)
+    points_per_zone: int | None
+    search: dict[str, Any]
+
+    def score(
+        self,
+        graph: ZoneGraph,
+        canvas: np.ndarray,
+        zones: np.ndarray,
+        ops: np.ndarray,
+        features: np.ndarray | None,
+    ) -> np.ndarray:
+        """Shapes: canvas (Z,) bool; zones (P, Z) bool; ops (P,) +1/-1; features (P, F); returns (P,)."""
+        ...
+
+
+class NumpyScorer:
+    """A :class:`FoldedScorer` with its graph's adjacency and geometry codes kept between states.
+
+    OpenBLAS would spread each small product over every core, and with the other core busy (two
+    pipeline workers on two cores) its threads wait on each other: a 40-zone state took 94 ms
+    instead of 2 ms. Scoring runs on one BLAS thread.
+    """
+
+    def __init__(self, folded: FoldedScorer) -> None:
+        from threadpoolctl import ThreadpoolController
+
+        self.folded = folded
+        self.columns = folded.columns
+        self.points_per_zone = folded.points_per_zone
+        self.search = folded.search
+        self._threads = ThreadpoolController()
+        self._graph: ZoneGraph | None = None
+        self._state: State | None = None
+        self._codes: np.ndarray | None = None
+
+    def score(
+        self,
+        graph: ZoneGraph,
+        canvas: np.ndarray,
+        zones: np.ndarray,
+        ops: np.ndarray,
+        features: np.ndarray | None,
+    ) -> np.ndarray:
+        with self._threads.limit(limits=1, user_api="blas"):
+            if graph is not self._graph or self._state is None:
+                self._graph = graph
+                self._state = State.of(graph.zone_inside, canvas, graph.edges.astype(np.int64))
+                points = zone_samples(graph, self.points_per_zone) if self.folded.points else None
+                self._codes = None if points is None else self.folded.encode_geometry(points)
+            state = self._state.with_canvas(canvas)
+            return self.folded.score(state, zones, ops.astype(np.float32), self._codes, features)
+
+
+def open_scorer(path: Path, device: str = "cpu") -> StateScorer:
+    """The scorer a checkpoint holds: numpy where it folds (a ``.npz``, or a late-fusion ``.pt``
+    on the CPU), PyTorch otherwise (which then must be installed)."""
+    if path.suffix == ".npz":
+        return NumpyScorer(FoldedScorer.load(path))
+    try:
+        from zonegraph.network.checkpoint import fold_checkpoint, read_checkpoint
+        from zonegraph.network.scoring import TorchScorer
+    except ImportError as exc:
+        raise ValueError(
+            f"{path}: a PyTorch checkpoint needs torch and torch_geometric (pip install 'zonegraph[train]'), "
+            "or its numpy export (python -m training.fold)"
+        ) from exc
+    checkpoint = read_checkpoint(path, device)
+    if checkpoint["model"].get("fusion", "late") == "late" and device == "cpu":
+        return NumpyScorer(fold_checkpoint(checkpoint))
+    return TorchScorer(checkpoint, device)
 
 
 class NetworkRanker:
-    """Scores proposals with a trained :class:`ProposalScorer` (P(positive), higher first)."""
+    """Scores proposals with a trained scorer (P(positive), higher first)."""
 
     samples = 128  # surface samples per zone the search builds graphs with: the checkpoint's own
 
@@ -45,30 +124,18 @@ class NetworkRanker:
         top_m: int | None = None,
         blend: float | None = None,
     ) -> None:
-        path = Path(model) if model else SHIPPED
+        path = Path(model) if model else SHIPPED_FOLDED
         if not path.is_file():
             raise ValueError(f"{path}: no model checkpoint (in a checkout: python -m training.train)")
-        torch.manual_seed(seed)
-        self.device = torch.device(device)
-        checkpoint = read_checkpoint(path, device)
-        self.model: ProposalScorer = scorer_from(checkpoint, device)
-        self.samples = int(checkpoint["train"].get("points_per_zone") or self.samples)
-        search = checkpoint.get("search", {})
+        self.seed = seed  # the forward is deterministic; kept for the Ranker factories' signature
+        self.scorer = open_scorer(path, device)
+        self.samples = int(self.scorer.points_per_zone or self.samples)
+        search = self.scorer.search
         self.top_m: int | None = top_m if top_m is not None else search.get("top_m")
         self.blend = float(blend if blend is not None else search.get("blend", 0.0))
         self._heuristic = HeuristicRanker()
         self._graph: ZoneGraph | None = None
-        self._geometry: Geometry | None = None
-        self._codes: torch.Tensor | None = None
         self._on_target: np.ndarray | None = None
-
-    def _prepare(self, graph: ZoneGraph) -> Geometry:
-        if graph is not self._graph or self._geometry is None:
-            self._graph, self._geometry = graph, geometry_of(graph, self.samples)
-            self._on_target = target_surfaces(graph)
-            with torch.no_grad():
-                self._codes = self.model.encode_geometry(self._geometry.points.to(self.device))
-        return self._geometry
 
     def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
         """(P,) scores of one state whose depth is not known (the step feature reads 0)."""
@@ -78,26 +145,26 @@ class NetworkRanker:
         self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int
     ) -> np.ndarray:
         """(P,) scores of every proposal of one state ``step`` operations deep: P(positive), or
-        its blend with the heuristic; proposals outside the heuristic's top M below them all."""
+        its blend with the heuristic; proposals outside the heuristic's top M below them all, a
+        proposal that completes the target above them all."""
         if not proposals:
             return np.zeros(0)
-        geometry = self._prepare(graph)
-        heuristic = None
-        if self.top_m or self.blend:
-            heuristic = self._heuristic.score(graph, canvas, proposals)
+        heuristic = self._heuristic.score(graph, canvas, proposals)
+        complete = heuristic >= 1.0  # every zone agrees with the target after the step
+        if complete.any():
+            return np.where(complete, COMPLETES + heuristic, UNSCORED + heuristic)
         chosen = np.arange(len(proposals))
-        if self.top_m and heuristic is not None and self.top_m < len(proposals):
+        if self.top_m and self.top_m < len(proposals):
             chosen = np.sort(np.argsort(-heuristic, kind="stable")[: self.top_m])
         picked = [proposals[i] for i in chosen]
-        zones = torch.from_numpy(np.stack([p.zones for p in picked]))
-        ops = torch.tensor([1 if p.op is Op.UNION else -1 for p in picked])
+        zones = np.stack([p.zones for p in picked]).astype(bool)
+        ops = np.array([1 if p.op is Op.UNION else -1 for p in picked])
         features = None
-        if self.model.columns:
-            features = torch.from_numpy(proposal_features(graph, canvas, picked, step, self._on_target))
-        canvas_t = torch.from_numpy(canvas.astype(bool))
-        net = score_state(self.model, geometry, canvas_t, zones, ops, self.device, self._codes, features)
-        if heuristic is None:
-            return net
+        if self.scorer.columns:
+            if graph is not self._graph:
+                self._graph, self._on_target = graph, target_surfaces(graph)
+            features = proposal_features(graph, canvas, picked, step, self._on_target)
+        net = self.scorer.score(graph, canvas.astype(bool), zones, ops, features)
         out = UNSCORED + heuristic
         out[chosen] = (1 - self.blend) * net + self.blend * heuristic[chosen]
         return out

@@ -8,13 +8,17 @@ a 500-zone graph would need about 17 GB.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import torch
 from torch import Tensor
 from torch_geometric.data import Batch
 
-from zonegraph.network.encoding import Geometry, state_data
+from zonegraph.network.checkpoint import scorer_from
+from zonegraph.network.encoding import Geometry, geometry_of, state_data
 from zonegraph.network.model import ProposalScorer
+from zonegraph.zones.model import ZoneGraph
 
 MAX_POINTS = 1_000_000  # zone samples per forward pass (early fusion)
 MAX_NODES = 200_000  # zone copies per forward pass (late and factored fusion)
@@ -54,3 +58,43 @@ def score_state(
         logits = model(Batch.from_data_list([data]).to(device), geometry=codes)
         scores.append(logits.softmax(dim=1)[:, 1].cpu())
     return torch.cat(scores).numpy() if scores else np.zeros(0)
+
+
+class TorchScorer:
+    """A checkpoint's :class:`ProposalScorer` behind the ranker's ``StateScorer`` protocol, for
+    what does not fold to numpy (early and factored fusion) or runs on another device."""
+
+    def __init__(self, checkpoint: dict[str, Any], device: str = "cpu") -> None:
+        self.device = torch.device(device)
+        self.model = scorer_from(checkpoint, device)
+        self.columns = tuple(self.model.columns)
+        samples = checkpoint["train"].get("points_per_zone")
+        self.points_per_zone = None if samples is None else int(samples)
+        self.search: dict[str, Any] = dict(checkpoint.get("search", {}))
+        self._graph: ZoneGraph | None = None
+        self._geometry: Geometry | None = None
+        self._codes: Tensor | None = None
+
+    def score(
+        self,
+        graph: ZoneGraph,
+        canvas: np.ndarray,
+        zones: np.ndarray,
+        ops: np.ndarray,
+        features: np.ndarray | None,
+    ) -> np.ndarray:
+        """Shapes: canvas (Z,) bool; zones (P, Z) bool; ops (P,) +1/-1; features (P, F); returns (P,)."""
+        if graph is not self._graph or self._geometry is None:
+            self._graph, self._geometry = graph, geometry_of(graph, self.points_per_zone or 128)
+            with torch.no_grad():
+                self._codes = self.model.encode_geometry(self._geometry.points.to(self.device))
+        return score_state(
+            self.model,
+            self._geometry,
+            torch.from_numpy(canvas.astype(bool)),
+            torch.from_numpy(zones.astype(bool)),
+            torch.from_numpy(ops.astype(np.int64)),
+            self.device,
+            self._codes,
+            None if features is None else torch.from_numpy(features),
+        )

@@ -1,0 +1,141 @@
+"""The scorer folded to numpy scores every proposal of real states as the PyTorch forward does."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from zonegraph.data.design import load_design
+from zonegraph.data.replay import replay
+from zonegraph.network.checkpoint import SHIPPED, fold, fold_checkpoint, read_checkpoint
+from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer
+from zonegraph.network.model import ModelConfig, ProposalScorer
+from zonegraph.network.ranker import COMPLETES, NetworkRanker, NumpyScorer, open_scorer
+from zonegraph.network.scoring import TorchScorer
+from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.sequence.features import FEATURES, proposal_features
+from zonegraph.sequence.proposals import Op, ProposalGenerator
+from zonegraph.sequence.rankers import HeuristicRanker
+from zonegraph.testing import requires_samples
+from zonegraph.zones.build import build_zone_graph
+
+
+def _trained_like(config: ModelConfig) -> ProposalScorer:
+    """A model with seeded weights and BatchNorm statistics far from the identity, so that a
+    fold that dropped or misplaced one would show."""
+    torch.manual_seed(0)
+    model = ProposalScorer(config)
+    for module in model.modules():
+        if isinstance(module, torch.nn.BatchNorm1d):
+            module.running_mean.normal_(0.0, 0.1)
+            module.running_var.uniform_(0.5, 2.0)
+            module.weight.data.uniform_(0.5, 1.5)
+            module.bias.data.normal_(0.0, 0.1)
+    return model.eval()
+
+
+@pytest.fixture(scope="module")
+def states(samples_dir):
+    """Two real graphs, each at its empty canvas and after its first proposal."""
+    found = []
+    for name in ("Couch.json", "Z0HexagonCutJoin_RootComponent.json"):
+        graph = build_zone_graph(list(replay(load_design(samples_dir / name)).bodies), samples=64)
+        generator = ProposalGenerator(graph)
+        canvas = np.zeros(graph.n_zones, bool)
+        for _ in range(2):
+            proposals = generator.proposals(canvas)
+            found.append((graph, canvas, proposals))
+            canvas = proposals[0].apply(canvas)
+    return found
+
+
+def _both(checkpoint: dict, graph, canvas, proposals) -> tuple[np.ndarray, np.ndarray]:
+    zones = np.stack([p.zones for p in proposals]).astype(bool)
+    ops = np.array([1 if p.op is Op.UNION else -1 for p in proposals])
+    features = proposal_features(graph, canvas, proposals, 1)
+    folded = NumpyScorer(fold_checkpoint(checkpoint)).score(graph, canvas, zones, ops, features)
+    reference = TorchScorer(checkpoint).score(graph, canvas, zones, ops, features)
+    return folded, reference
+
+
+@requires_samples
+@pytest.mark.parametrize(
+    "config",
+    [
+        ModelConfig(use_points=False, features=FEATURES),
+        ModelConfig(use_points=True, features=("depth", "union", "step")),
+        ModelConfig(use_points=True, rounds=2),
+    ],
+    ids=["flags+features", "points+features", "points"],
+)
+def test_a_folded_scorer_scores_real_states_as_pytorch(states, config):
+    model = _trained_like(config)
+    checkpoint = {
+        "model": config.__dict__,
+        "state_dict": model.state_dict(),
+        "train": {"points_per_zone": 16},
+    }
+    for graph, canvas, proposals in states:
+        folded, reference = _both(checkpoint, graph, canvas, proposals)
+        assert folded.shape == (len(proposals),)
+        error = np.abs(folded - reference).max()
+        assert error < 2e-5 and error < 0.01 * np.ptp(reference)  # well below what tells proposals apart
+
+
+@requires_samples
+def test_the_shipped_folded_weights_are_the_shipped_checkpoint_folded(states):
+    checkpoint = read_checkpoint(SHIPPED)
+    shipped, fresh = FoldedScorer.load(SHIPPED_FOLDED), fold_checkpoint(checkpoint)
+    assert shipped.config == fresh.config and shipped.search == fresh.search == checkpoint["search"]
+    assert shipped.points_per_zone == checkpoint["train"]["points_per_zone"]
+    for mine, theirs in zip(shipped._chains().values(), fresh._chains().values(), strict=True):
+        for a, b in zip(sum(mine, ()), sum(theirs, ()), strict=True):
+            assert np.array_equal(a.weight, b.weight) and np.array_equal(a.bias, b.bias)
+    for graph, canvas, proposals in states:
+        folded, reference = _both(checkpoint, graph, canvas, proposals)
+        np.testing.assert_allclose(folded, reference, atol=2e-5)
+
+
+def test_what_does_not_fold_stays_on_pytorch(tmp_path):
+    with pytest.raises(ValueError, match="only late fusion"):
+        fold(_trained_like(ModelConfig(fusion="early")))
+    path = tmp_path / "early.pt"
+    model = _trained_like(ModelConfig(fusion="factored"))
+    torch.save({"model": model.config.__dict__, "state_dict": model.state_dict(), "train": {}}, path)
+    assert isinstance(open_scorer(path), TorchScorer)
+    assert isinstance(open_scorer(SHIPPED), NumpyScorer)
+    assert isinstance(open_scorer(SHIPPED_FOLDED), NumpyScorer)
+
+
+@requires_samples
+def test_a_proposal_that_completes_the_target_goes_first_unscored(states):
+    graph = states[0][0]  # Couch: a box, then a cut
+    found = search(graph, HeuristicRanker(), SearchConfig(budget_s=float("inf"), max_expansions=50))
+    assert found.exact and len(found.steps) >= 2
+    canvas = np.zeros(graph.n_zones, bool)
+    for step in found.steps[:-1]:
+        canvas = step.apply(canvas)
+    proposals = ProposalGenerator(graph).proposals(canvas)
+    target = graph.zone_inside.astype(bool)
+    finishing = [i for i, p in enumerate(proposals) if np.array_equal(p.apply(canvas), target)]
+    scores = NetworkRanker().score_at(graph, canvas, proposals, len(found.steps) - 1)
+    assert finishing and int(np.argmax(scores)) in finishing
+    assert (scores >= COMPLETES).sum() == len(finishing)
+
+
+@requires_samples
+def test_computing_only_the_zones_within_reach_scores_as_computing_every_zone(states, monkeypatch):
+    folded = fold(_trained_like(ModelConfig(use_points=False, features=FEATURES)))
+    scorer, paths = NumpyScorer(folded), []
+    for graph, canvas, proposals in states:
+        zones = np.stack([p.zones for p in proposals]).astype(bool)
+        ops = np.array([1 if p.op is Op.UNION else -1 for p in proposals])
+        features = proposal_features(graph, canvas, proposals, 0)
+        chosen = scorer.score(graph, canvas, zones, ops, features)
+        paths.append(len(folded._computed(scorer._state, zones)[0]) - len(proposals))
+        with monkeypatch.context() as patch:
+            patch.setattr(FoldedScorer, "_computed", lambda self, state, z: [np.ones(z.shape, bool)] * 4)
+            every = scorer.score(graph, canvas, zones, ops, features)
+        np.testing.assert_allclose(chosen, every, atol=1e-6)
+    assert 1 in paths, "no state took the within-reach path: the comparison tests nothing"
