@@ -258,7 +258,8 @@ def _median_ratio(times: pd.DataFrame, guide: str, reference: str, seed: int = 0
     draws = np.random.default_rng(seed).integers(0, len(pair), (2000, len(pair)))
     boot = np.array([ratio(pair[d]) for d in draws])
     low, high = np.nanpercentile(boot, [5, 95])
-    return {"designs": len(pair), "ratio": round(ratio(pair), 3), "ci": [round(float(low), 3), round(float(high), 3)]}
+    interval = [round(float(low), 3), round(float(high), 3)]
+    return {"designs": len(pair), "ratio": round(ratio(pair), 3), "ci": interval}
 
 
 def _median(values: pd.Series, digits: int) -> float | None:
