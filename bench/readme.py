@@ -71,7 +71,8 @@ def named(text: str) -> list[str]:
 def newest(sample: str) -> str | None:
     """The figure of ``sample`` (``tuning``, ``validation``) whose commit is the newest in the
     history, or None where none of their commits is in it."""
-    order = subprocess.run(["git", "rev-list", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.split()
+    history = subprocess.run(["git", "rev-list", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+    order = history.stdout.split()
     rank = {sha[:7]: i for i, sha in enumerate(order)}
     commits = {p.stem: json.loads(p.read_text())["commit"][:7] for p in FIGURES.glob(f"{sample}-*.json")}
     known = {name: rank[c] for name, c in commits.items() if c in rank}
