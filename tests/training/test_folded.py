@@ -139,3 +139,16 @@ def test_computing_only_the_zones_within_reach_scores_as_computing_every_zone(st
             every = scorer.score(graph, canvas, zones, ops, features)
         np.testing.assert_allclose(chosen, every, atol=1e-6)
     assert 1 in paths, "no state took the within-reach path: the comparison tests nothing"
+
+
+@requires_samples
+def test_a_scorer_reading_some_features_scores_without_them_as_pytorch_with_zeros(states):
+    config = ModelConfig(use_points=False, features=("depth", "step"))
+    model = _trained_like(config)
+    checkpoint = {"model": config.__dict__, "state_dict": model.state_dict(), "train": {}}
+    graph, canvas, proposals = states[2]
+    zones = np.stack([p.zones for p in proposals]).astype(bool)
+    ops = np.array([1 if p.op is Op.UNION else -1 for p in proposals])
+    folded = NumpyScorer(fold_checkpoint(checkpoint)).score(graph, canvas, zones, ops, None)
+    reference = TorchScorer(checkpoint).score(graph, canvas, zones, ops, None)
+    np.testing.assert_allclose(folded, reference, atol=2e-5)

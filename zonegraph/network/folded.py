@@ -134,7 +134,7 @@ class FoldedScorer:
             x = _spread(run(chain, np.concatenate([x[rows], mean[rows]], axis=1)), rows, k, z, k > p)
         pooled = x[own].max(axis=1)
         if self.columns:
-            taken = np.zeros((p, len(self.columns)), np.float32) if features is None else features
+            taken = np.zeros((p, max(self.columns) + 1), np.float32) if features is None else features
             pooled = np.concatenate([pooled, run(self.features, taken[:, list(self.columns)])], axis=1)
         logits = run(self.readout, pooled)
         return 1.0 / (1.0 + np.exp(logits[:, 0] - logits[:, 1]))
