@@ -1,13 +1,15 @@
 """The network guide at inference: the proposal scorer, its input encoding, checkpoint loading,
 the ranker and the shipped checkpoint (paper sec. 4.2).
 
-Layout (issue 22): everything a user of ``--guide net`` needs lives here, inside the one
-installed package, so ``pip install 'zonegraph[train]'`` is enough to run it; the training loop,
-the loss, the label dataset and the model card writer stay in the checkout's ``training/``
-folder, run with ``python -m`` like the pipeline's stages. This is the one layer that imports
-torch and torch_geometric; nothing outside it imports it eagerly (:mod:`zonegraph.plugins` names
-the ranker by reference), and this ``__init__`` imports its names on first use, so
-``import zonegraph.network`` alone loads no torch either.
+Layout: everything a user of ``--guide net`` needs lives here, inside the one installed
+package. The shipped weights run folded to numpy (:mod:`zonegraph.network.folded`), so the core
+install runs the guide; ``pip install 'zonegraph[train]'`` adds PyTorch checkpoints. The
+training loop, the loss, the label dataset and the model card writer stay in the checkout's
+``training/`` folder, run with ``python -m`` like the pipeline's stages. This is the one layer
+that imports torch and torch_geometric (``folded`` and ``ranker`` do not); nothing outside it
+imports it eagerly (:mod:`zonegraph.plugins` names the ranker by reference), and this
+``__init__`` imports its names on first use, so ``import zonegraph.network`` alone loads no
+torch either.
 """
 
 from __future__ import annotations
@@ -28,13 +30,17 @@ _EXPORTS = {
     "load_scorer": "zonegraph.network.checkpoint",
     "scorer_from": "zonegraph.network.checkpoint",
     "NetworkRanker": "zonegraph.network.ranker",
+    "FoldedScorer": "zonegraph.network.folded",
+    "SHIPPED_FOLDED": "zonegraph.network.folded",
+    "fold": "zonegraph.network.checkpoint",
 }
 
 __all__ = sorted(_EXPORTS)
 
 if TYPE_CHECKING:
-    from zonegraph.network.checkpoint import SHIPPED, load_scorer, scorer_from
+    from zonegraph.network.checkpoint import SHIPPED, fold, load_scorer, scorer_from
     from zonegraph.network.encoding import Geometry, StateData, geometry_of, state_data
+    from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer
     from zonegraph.network.model import ModelConfig, ProposalScorer
     from zonegraph.network.ranker import NetworkRanker
     from zonegraph.network.scoring import score_state

@@ -2,8 +2,9 @@
 
 A checkpoint holds the model's configuration beside its weights (``training.train`` writes them,
 with the training configuration, metrics and provenance its model card reads), so loading needs
-nothing but the file. The shipped checkpoint is package data: ``--guide net`` works after
-``pip install 'zonegraph[train]'``, without a checkout.
+nothing but the file. The shipped checkpoint is package data, beside its numpy fold
+(:func:`fold_checkpoint`, ``scorer.npz``) which ``--guide net`` loads, so the guide works
+without a checkout and without torch.
 """
 
 from __future__ import annotations
