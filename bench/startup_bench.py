@@ -1,7 +1,7 @@
 """Whole-process cost of one ``zonegraph build`` (and ``infer``) per part, beside the original.
 
     python -m bench.startup_bench [--designs data/designs/json] [--per-folder 3] [--seed 7]
-                                  [--exclude FILE] [--budget 1] [--no-infer]
+                                  [--exclude FILE] [--budget 1] [--guide heuristic] [--no-infer]
                                   [--original DIR] [--freecad-python PY] [--original-deps DIR]
                                   [--timeout 600] [--out bench_out/startup]
 
@@ -11,7 +11,7 @@ drawn with ``--seed`` from those whose converted JSON is in ``--designs`` and wh
 Each is replayed once to ``PART.step`` (centimetres declared), the input both sides read.
 
 Each part then runs as its own process, as a user's single call does: ``python -m zonegraph.cli
-build PART.step`` (and ``infer PART.step --budget B``), measured by ``os.wait4``: CPU seconds (user
+build PART.step`` (and ``infer PART.step --budget B --guide G``), measured by ``os.wait4``: CPU seconds (user
 + sys of the process and every child it reaped, so a loaded machine does not inflate them), wall
 seconds and peak resident memory (the largest of the process and its children). The original
 implementation (brownvc/zone-graphs on FreeCAD) runs the same way when ``--original`` names its
@@ -142,7 +142,7 @@ def run_part(step: Path, work: Path, args: argparse.Namespace, original_ok: bool
     row: dict = {"part": step.stem, "step_bytes": step.stat().st_size}
     runs = {"build": cli + ["build", str(step), "--out", str(work / f"{step.stem}_build")]}
     if not args.no_infer:
-        budget = ["--budget", str(args.budget)]
+        budget = ["--budget", str(args.budget), "--guide", args.guide]
         runs["infer"] = cli + ["infer", str(step), "--out", str(work / f"{step.stem}_infer"), *budget]
     if original_ok:
         src = args.original / "src"
@@ -216,6 +216,7 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--seed", type=int, default=7)
     p.add_argument("--exclude", type=Path, default=None, help="ids never drawn, one a line")
     p.add_argument("--budget", type=float, default=1.0, help="infer's search seconds")
+    p.add_argument("--guide", default="heuristic", help="infer's guide (net: the shipped network)")
     p.add_argument("--no-infer", action="store_true")
     p.add_argument("--original", type=Path, default=None, help="a brownvc/zone-graphs checkout")
     p.add_argument("--freecad-python", default="/usr/bin/python3", help="the Python that imports FreeCAD")
