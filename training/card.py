@@ -51,6 +51,8 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
         architecture(model),
         f"Size: {path.stat().st_size / 1e6:.2f} MB, "
         f"{sum(v.numel() for v in checkpoint['state_dict'].values()):,} parameters.",
+        f"The guide runs it folded to numpy as `{path.with_suffix('.npz').name}` where it folds (late "
+        f"fusion: `python -m training.fold {path.name}`), with no torch.",
         "",
         "## Data",
         "",
