@@ -58,7 +58,9 @@ class GuideSpec:
             raise SystemExit(f"guide_cost_bench: {spec}: unknown option {sorted(unknown)} (top_m, blend)")
         top_m = int(options["top_m"]) if "top_m" in options else None
         blend = float(options["blend"]) if "blend" in options else None
-        label = f"net:{Path(model).parent.name or model}" + (f"@{knobs}" if knobs else "")
+        shipped = Path(model).name == "scorer.pt" and Path(model).parent.name == "checkpoints"
+        name = "shipped" if shipped else Path(model).parent.name or model
+        label = f"net:{name}" + (f"@{knobs}" if knobs else "")
         return cls(label, "net", model or None, top_m, blend)
 
     def ranker(self, seed: int) -> Ranker:
