@@ -10,6 +10,7 @@
     python -m bench.figures fault NAME DIR/results.json --command "python -m bench.fault_bench ..."
     python -m bench.figures build|search|replay NAME DIR/results.json --command "python -m bench..."
     python -m bench.figures guide-cost NAME DIR/guide_cost.json --command "python -m bench.guide_cost..."
+    python -m bench.figures report NAME REPORT_DIR --command "python -m eval.report ..."
 
 A results page never carries a number typed by hand: a benchmark's ``results.json`` (its per-design
 rows, or its summary) is reduced here to a small figure file, ``docs/figures/NAME.json``, holding
@@ -291,6 +292,35 @@ def guide_cost_figure(results: dict, reference: str = "heuristic") -> dict:
     return {"reference": reference, "budgets": budgets}
 
 
+REPORT_TIMES = (0.5, 1.0, 5.0, 20.0)  # the search seconds the evaluation's figure reads its curves at
+
+
+def _curve_points(curves: pd.DataFrame) -> dict:
+    """Per guide: designs, and mean IoU and exact rate at each of REPORT_TIMES (the last point of
+    its curve at or before that time)."""
+    out = {}
+    for guide, group in curves.groupby("guide", sort=False):
+        group = group.sort_values("seconds")
+        points = {}
+        for t in REPORT_TIMES:
+            before = group[group["seconds"] <= t + 1e-9]
+            if len(before):
+                last = before.iloc[-1]
+                iou, exact = round(float(last["mean_iou"]), 4), round(float(last["exact_rate"]), 4)
+                points[f"{t:g}"] = {"iou": iou, "exact": exact}
+        out[str(guide)] = {"designs": int(group["designs"].iloc[0]), "at": points}
+    return out
+
+
+def report_figure(folder: Path) -> dict:
+    """The evaluation report's IoU and exact rate vs search time (``eval.report``'s
+    ``curves.csv`` and ``curves_gt3.csv``), per guide at REPORT_TIMES."""
+    figure = {"all": _curve_points(pd.read_csv(folder / "curves.csv"))}
+    if (folder / "curves_gt3.csv").is_file():
+        figure["gt3"] = _curve_points(pd.read_csv(folder / "curves_gt3.csv"))
+    return figure
+
+
 FIGURES_OF = {
     "build": build_figure,
     "search": search_figure,
@@ -329,7 +359,7 @@ def write_figure(
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("kind", choices=[*FIGURES_OF, "fusion-diff"])
+    ap.add_argument("kind", choices=[*FIGURES_OF, "fusion-diff", "report"])
     ap.add_argument("name", help="the figure's file name under --out, without .json")
     ap.add_argument("results", type=Path, help="the benchmark's results.json")
     ap.add_argument("--command", required=True, help="the command that wrote RESULTS")
@@ -337,8 +367,12 @@ def main() -> None:
     ap.add_argument("--measured", default=date.today().isoformat(), help="the day it ran (default: today)")
     ap.add_argument("--out", type=Path, default=FIGURES)
     args = ap.parse_args()
-    data = pd.read_parquet(args.results) if args.kind == "coverage" else json.loads(args.results.read_text())
-    figure = FIGURES_OF[args.kind](data) if args.kind in FIGURES_OF else data
+    if args.kind == "report":
+        figure = report_figure(args.results)
+    else:
+        coverage = args.kind == "coverage"
+        data = pd.read_parquet(args.results) if coverage else json.loads(args.results.read_text())
+        figure = FIGURES_OF[args.kind](data) if args.kind in FIGURES_OF else data
     commit = args.commit or head_commit()
     path = write_figure(args.kind, args.name, figure, args.command, commit, args.measured, args.out)
     print(f"wrote {path}")

@@ -308,6 +308,27 @@ def guide_cost(records: list[dict]) -> str:
     return "\n".join(lines) + note + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def report(records: list[dict]) -> str:
+    """IoU and exact rate vs search time per guide, all designs and GT length >= 3."""
+    (r,) = records
+    lines = []
+    for part, title in (("all", "designs searched"), ("gt3", "GT length >= 3")):
+        guides = r["figure"].get(part)
+        if not guides:
+            continue
+        times = sorted({t for g in guides.values() for t in g["at"]}, key=float)
+        lines += [
+            f"| guide ({title}) | designs | " + " | ".join(f"IoU / exact at {t} s" for t in times) + " |",
+            "|---|---|" + "---|" * len(times),
+        ]
+        for name, g in guides.items():
+            at = g["at"]
+            cells = [f"{at[t]['iou']:.3f} / {at[t]['exact']:.1%}" if t in at else "-" for t in times]
+            lines.append(f"| {name} | {g['designs']} | " + " | ".join(cells) + " |")
+        lines.append("")
+    return "\n".join(lines) + "\nMeasured by:\n\n" + _sources(records)
+
+
 RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "build": build,
     "search": search,
@@ -320,6 +341,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "coverage": coverage,
     "fuzz": fuzz,
     "guide-cost": guide_cost,
+    "report": report,
 }
 
 

@@ -16,6 +16,7 @@ from bench.figures import (
     fault_figure,
     fuzz_figure,
     guide_cost_figure,
+    report_figure,
 )
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -229,3 +230,22 @@ def test_the_guide_cost_figure_compares_each_guide_on_the_designs_both_solved():
     record = {"name": "run", "command": "python -m bench.guide_cost_bench", "commit": "abc1234"}
     table = _hook().guide_cost([record | {"measured": "2026-12-05", "figure": figure}])
     assert "| run | 1 | net | 3/3 (100.0%) | 2/2 (100.0%) | 0.0025 | 2 | 0.83 (" in table
+
+
+def test_the_report_figure_reads_each_curve_at_the_last_point_before_each_time(tmp_path):
+    rows = [
+        ("heuristic", 0.001, 0.0, 0.0),
+        ("heuristic", 0.4, 0.9, 0.5),
+        ("heuristic", 0.9, 1.0, 1.0),
+        ("net", 0.001, 0.0, 0.0),
+        ("net", 3.0, 0.8, 0.5),
+    ]
+    curves = pd.DataFrame(rows, columns=["guide", "seconds", "mean_iou", "exact_rate"]).assign(designs=2)
+    curves.to_csv(tmp_path / "curves.csv", index=False)
+    figure = report_figure(tmp_path)
+    heuristic, net = figure["all"]["heuristic"]["at"], figure["all"]["net"]["at"]
+    assert heuristic["0.5"] == {"iou": 0.9, "exact": 0.5} and heuristic["1"]["exact"] == 1.0
+    assert net["1"] == {"iou": 0.0, "exact": 0.0} and net["5"]["exact"] == 0.5 and "gt3" not in figure
+    record = {"name": "r", "command": "python -m eval.report", "commit": "abc1234", "measured": "2026-12-05"}
+    table = _hook().report([record | {"figure": figure}])
+    assert "| heuristic | 2 | 0.900 / 50.0% | 1.000 / 100.0% | 1.000 / 100.0% | 1.000 / 100.0% |" in table
