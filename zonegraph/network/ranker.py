@@ -20,10 +20,12 @@ zone) goes first unscored: it ends the search, whatever a scorer would say of it
 
 from __future__ import annotations
 
+from functools import cache
 from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State, zone_samples
 from zonegraph.sequence.features import proposal_features, target_surfaces
@@ -63,13 +65,10 @@ class NumpyScorer:
     """
 
     def __init__(self, folded: FoldedScorer) -> None:
-        from threadpoolctl import ThreadpoolController
-
         self.folded = folded
         self.columns = folded.columns
         self.points_per_zone = folded.points_per_zone
         self.search = folded.search
-        self._threads = ThreadpoolController()
         self._graph: ZoneGraph | None = None
         self._state: State | None = None
         self._codes: np.ndarray | None = None
@@ -82,7 +81,7 @@ class NumpyScorer:
         ops: np.ndarray,
         features: np.ndarray | None,
     ) -> np.ndarray:
-        with self._threads.limit(limits=1, user_api="blas"):
+        with _blas_threads().limit(limits=1, user_api="blas"):
             if graph is not self._graph or self._state is None:
                 self._graph = graph
                 self._state = State.of(graph.zone_inside, canvas, graph.edges.astype(np.int64))
@@ -90,6 +89,12 @@ class NumpyScorer:
                 self._codes = None if points is None else self.folded.encode_geometry(points)
             state = self._state.with_canvas(canvas)
             return self.folded.score(state, zones, ops.astype(np.float32), self._codes, features)
+
+
+@cache
+def _blas_threads() -> ThreadpoolController:
+    """The process's BLAS thread pools (finding them reads every loaded library: once)."""
+    return ThreadpoolController()
 
 
 def open_scorer(path: Path, device: str = "cpu") -> StateScorer:
