@@ -32,7 +32,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from bench.guide_cost_bench import summary
 from eval.coverage import CATEGORIES, LABELS, coverage_table
+from eval.curves import at_time
 from zonegraph.status import Status
 
 FIGURES = Path("docs/figures")
@@ -263,32 +265,29 @@ def _median_ratio(times: pd.DataFrame, guide: str, reference: str, seed: int = 0
     return {"designs": len(pair), "ratio": round(ratio(pair), 3), "ci": interval}
 
 
-def _median(values: pd.Series, digits: int) -> float | None:
-    return round(float(values.median()), digits) if len(values) else None
+def _rounded(value: float | None, digits: int) -> float | None:
+    return None if value is None or pd.isna(value) else round(float(value), digits)
 
 
 def guide_cost_figure(results: dict, reference: str = "heuristic") -> dict:
-    """The guide cost benchmark by budget and guide: exact (all designs and GT >= 3), medians on
-    the designs every guide solved, and each guide's median time to exact over the reference's
-    on the designs both solved."""
+    """The guide cost benchmark by budget and guide: its own summary (exact, all designs and
+    GT >= 3; medians on the designs every guide solved) and each guide's median time to exact
+    over the reference's on the designs both solved."""
     rows = pd.DataFrame(results["rows"])
-    budgets = {}
-    for budget, at in rows.groupby("budget"):
+    budgets: dict[str, dict] = {}
+    for r in summary(rows).to_dict(orient="records"):
+        at = rows[rows["budget"] == r["budget_s"]]
         times = at.pivot(index="design_id", columns="guide", values="time_to_exact_s")
-        common = set(at.groupby("design_id")["exact"].all().loc[lambda s: s].index)
-        guides = {}
-        for guide, group in at.groupby("guide", sort=False):
-            long, both = group[group["gt_steps"] >= 3], group[group["design_id"].isin(common)]
-            guides[str(guide)] = {
-                "exact": int(group["exact"].sum()),
-                "designs": len(group),
-                "exact_gt3": int(long["exact"].sum()),
-                "designs_gt3": len(long),
-                "median_time_to_exact_s": _median(both["time_to_exact_s"], 5),
-                "median_expansions": _median(both["expansions"], 1),
-                "time_ratio": _median_ratio(times, str(guide), reference) if guide != reference else None,
-            }
-        budgets[f"{budget:g}"] = {"common": len(common), "guides": guides}
+        entry = budgets.setdefault(f"{r['budget_s']:g}", {"common": int(r["common"]), "guides": {}})
+        entry["guides"][str(r["guide"])] = {
+            "exact": int(r["exact"]),
+            "designs": int(r["designs"]),
+            "exact_gt3": int(r["exact_gt3"]),
+            "designs_gt3": int(r["designs_gt3"]),
+            "median_time_to_exact_s": _rounded(r["median_time_to_exact_s"], 5),
+            "median_expansions": _rounded(r["median_expansions"], 1),
+            "time_ratio": None if r["guide"] == reference else _median_ratio(times, r["guide"], reference),
+        }
     return {"reference": reference, "budgets": budgets}
 
 
@@ -296,18 +295,15 @@ REPORT_TIMES = (0.5, 1.0, 5.0, 20.0)  # the search seconds the evaluation's figu
 
 
 def _curve_points(curves: pd.DataFrame) -> dict:
-    """Per guide: designs, and mean IoU and exact rate at each of REPORT_TIMES (the last point of
-    its curve at or before that time)."""
+    """Per guide: designs, and mean IoU and exact rate at each of REPORT_TIMES, read as the
+    report reads them (:func:`eval.curves.at_time`)."""
     out = {}
     for guide, group in curves.groupby("guide", sort=False):
-        group = group.sort_values("seconds")
         points = {}
         for t in REPORT_TIMES:
-            before = group[group["seconds"] <= t + 1e-9]
-            if len(before):
-                last = before.iloc[-1]
-                iou, exact = round(float(last["mean_iou"]), 4), round(float(last["exact_rate"]), 4)
-                points[f"{t:g}"] = {"iou": iou, "exact": exact}
+            at = at_time(group, t)
+            iou, exact = round(float(at["mean_iou"]), 4), round(float(at["exact_rate"]), 4)
+            points[f"{t:g}"] = {"iou": iou, "exact": exact}
         out[str(guide)] = {"designs": int(group["designs"].iloc[0]), "at": points}
     return out
 

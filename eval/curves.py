@@ -66,6 +66,12 @@ def curves(results: pd.DataFrame, times: np.ndarray) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def at_time(curve: pd.DataFrame, seconds: float) -> pd.Series:
+    """The row of one guide's curve (:func:`curves`) whose time is nearest ``seconds``: how the
+    report and its figures read a curve at a mark."""
+    return curve.iloc[int(np.argmin(np.abs(curve["seconds"].to_numpy() - seconds)))]
+
+
 def _trace(value: object) -> list:
     if value is None or (isinstance(value, float) and np.isnan(value)):
         return []

@@ -29,11 +29,10 @@ import shutil
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 import zonegraph.network
-from eval.curves import curves, plot_curves, time_grid
+from eval.curves import at_time, curves, plot_curves, time_grid
 from eval.dvc_metrics import rounded, write_guides
 from eval.heldout import held_out, held_out_labelled, trained_projects
 from eval.programs import program_measures
@@ -295,7 +294,7 @@ def _marks_md(table: pd.DataFrame) -> str:
     for guide, group in table.groupby("guide", sort=False):
         cells = []
         for mark in marks:
-            at = group.iloc[int(np.argmin(np.abs(group["seconds"] - mark)))]
+            at = at_time(group, mark)
             cells.append(f"{at.mean_iou:.3f} / {at.exact_rate:.1%}")
         rows.append(f"| {guide} | " + " | ".join(cells) + " |")
     head = "| guide | " + " | ".join(f"IoU / exact at {m:g} s" for m in marks) + " |"
@@ -313,7 +312,7 @@ def metrics_of(rank: pd.DataFrame, curve_table: pd.DataFrame) -> dict[str, float
     main = curve_table[curve_table["k"] == 5] if len(curve_table) else curve_table
     for guide, group in main.groupby("guide", sort=False):
         for mark in _marks(main):
-            at = group.iloc[int(np.argmin(np.abs(group["seconds"] - mark)))]
+            at = at_time(group, mark)
             metrics[f"iou_at_{mark:g}s.{guide}"] = float(at.mean_iou)
             metrics[f"exact_at_{mark:g}s.{guide}"] = float(at.exact_rate)
     return {k.replace(":", "_"): v for k, v in metrics.items()}

@@ -167,7 +167,7 @@ def _cmd_build(args: argparse.Namespace) -> int:
 
 def _guide_error(config: InferConfig) -> str | None:
     """Why the guide or its model cannot be used, checked before the kernel is imported."""
-    from zonegraph.plugins import guide_problem
+    from zonegraph.plugins import guide_problem, model_problem
 
     problem = guide_problem(config.guide)
     if problem is not None:
@@ -176,19 +176,7 @@ def _guide_error(config: InferConfig) -> str | None:
         return f"--model {config.model}: the {config.guide} guide uses no model (only --guide net does)"
     if config.model is not None and not Path(config.model).is_file():
         return f"{config.model}: no such model checkpoint"
-    if config.model is not None and Path(config.model).suffix != ".npz" and not _torch_installed():
-        return (
-            f"{config.model}: a PyTorch checkpoint needs torch and torch_geometric: "
-            "pip install 'zonegraph[train]' (the shipped weights need neither)"
-        )
-    return None
-
-
-def _torch_installed() -> bool:
-    """Whether torch and torch_geometric can be imported (found, not imported)."""
-    from importlib.util import find_spec
-
-    return all(find_spec(name) is not None for name in ("torch", "torch_geometric"))
+    return None if config.model is None else model_problem(str(config.model))
 
 
 def _infer_job(config: InferConfig, timeout: float, memory_mb: int | None) -> BatchJob:

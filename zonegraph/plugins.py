@@ -35,6 +35,10 @@ class ExtraGuide:
         return all(find_spec(name) is not None for name in self.requires)
 
 
+PYTORCH = ExtraGuide("zonegraph.network.checkpoint:read_checkpoint", "train", ("torch", "torch_geometric"))
+"""What reading a PyTorch checkpoint (``--model X.pt``) needs; the shipped weights, folded to
+numpy (``.npz``), need none of it."""
+
 EXTRA_GUIDES = {
     # PyTorch checkpoints (--model X.pt) need the train extra: zonegraph.cli checks those
     "net": ExtraGuide("zonegraph.network.ranker:NetworkRanker", "train", ()),
@@ -58,6 +62,15 @@ def missing_extra(guide: str) -> str | None:
     """The extra a guide zonegraph ships needs and this installation lacks, or None."""
     shipped = EXTRA_GUIDES.get(guide)
     return shipped.extra if shipped is not None and not shipped.installed() else None
+
+
+def model_problem(model: str) -> str | None:
+    """Why the network guide cannot read checkpoint ``model`` here, in one line, or None."""
+    if model.endswith(".npz") or PYTORCH.installed():
+        return None
+    needs = " and ".join(PYTORCH.requires)
+    install = f"pip install 'zonegraph[{PYTORCH.extra}]'"
+    return f"{model}: a PyTorch checkpoint needs {needs}: {install} (the shipped weights need neither)"
 
 
 def guide_problem(guide: str) -> str | None:

@@ -206,6 +206,7 @@ def test_the_guide_cost_figure_compares_each_guide_on_the_designs_both_solved():
             "budget": 1.0,
             "exact": exact,
             "time_to_exact_s": seconds if exact else None,
+            "search_cpu_s": 0.01,
             "expansions": 2,
         }
 

@@ -41,13 +41,17 @@ def scorer_from(checkpoint: dict[str, Any], device: str = "cpu") -> ProposalScor
     return model.eval().to(device)
 
 
-def fold_checkpoint(checkpoint: dict[str, Any]) -> FoldedScorer:
-    """A late-fusion checkpoint's scorer as numpy arrays, with its samples per zone and the
-    search defaults stored beside its weights."""
-    folded = fold(scorer_from(checkpoint))
+def guide_settings(checkpoint: dict[str, Any]) -> tuple[int | None, dict[str, Any]]:
+    """The surface samples per zone it trained with, and the search defaults stored beside its
+    weights (``top_m``, ``blend``)."""
     samples = checkpoint.get("train", {}).get("points_per_zone")
-    search = dict(checkpoint.get("search", {}))
-    return replace(folded, points_per_zone=None if samples is None else int(samples), search=search)
+    return None if samples is None else int(samples), dict(checkpoint.get("search", {}))
+
+
+def fold_checkpoint(checkpoint: dict[str, Any]) -> FoldedScorer:
+    """A late-fusion checkpoint's scorer as numpy arrays, with its :func:`guide_settings`."""
+    samples, search = guide_settings(checkpoint)
+    return replace(fold(scorer_from(checkpoint)), points_per_zone=samples, search=search)
 
 
 def fold(model: ProposalScorer) -> FoldedScorer:

@@ -82,19 +82,22 @@ class FoldedScorer:
     search: dict[str, Any] = field(default_factory=dict)  # the guide's defaults (top_m, blend)
 
     def encode_geometry(self, points: np.ndarray) -> np.ndarray | None:
-        """(Z, hidden) zone codes from (Z, 6, S) samples, once per graph; None without points."""
+        """(Z, H) each zone's geometry as it enters ``zone_in``'s first layer (its PointNet code
+        times that layer's geometry rows), from (Z, 6, S) samples: once per graph. None without
+        points."""
         if not self.points:
             return None
         z, c, s = points.shape
         per_point = run(self.points, points.transpose(0, 2, 1).reshape(z * s, c).astype(np.float32))
-        return run(self.head, per_point.reshape(z, s, -1).max(axis=1))
+        codes = run(self.head, per_point.reshape(z, s, -1).max(axis=1))
+        return codes @ self.zone_in[0].weight[:-4]
 
     def score(
         self,
         state: State,
         zones: np.ndarray,
         ops: np.ndarray,
-        codes: np.ndarray | None = None,
+        geometry: np.ndarray | None = None,
         features: np.ndarray | None = None,
     ) -> np.ndarray:
         """P(positive) of each of P proposals of one state.
@@ -109,7 +112,7 @@ class FoldedScorer:
         state's.
 
         Shapes:
-            zones: (P, Z) bool, the extrusions; ops: (P,) +1 union, -1 subtract; codes: (Z, H)
+            zones: (P, Z) bool, the extrusions; ops: (P,) +1 union, -1 subtract; geometry: (Z, H)
             from :meth:`encode_geometry`; features: (P, F) every column of FEATURES; returns (P,).
         """
         p, z = zones.shape
@@ -123,15 +126,16 @@ class FoldedScorer:
         flags[own, :, 2] = zones
         flags[own, :, 3] = zones * ops[:, None]
         rows = np.nonzero(masks[0])
-        geometry = first.bias if codes is None else codes @ first.weight[:-4] + first.bias
-        geometry = np.broadcast_to(geometry, (z, len(first.bias)))
-        x = first_activation(flags[rows] @ first.weight[-4:] + geometry[rows[1]], first)
-        x = _spread(run(self.zone_in[1:], x), rows, k, z, with_state=k > p)
+        x = flags[rows] @ first.weight[-4:] + first.bias
+        if geometry is not None:
+            x += geometry[rows[1]]
+        x = _spread(run(self.zone_in[1:], _activate(x, first)), rows, k, z, with_state=k > p)
         for chain, mask in zip(self.rounds, masks[1:], strict=True):
             rows = np.nonzero(mask)
             mean = state.neighbours @ x.transpose(1, 0, 2).reshape(z, -1)
             mean = mean.reshape(z, k, -1).transpose(1, 0, 2)
-            x = _spread(run(chain, np.concatenate([x[rows], mean[rows]], axis=1)), rows, k, z, k > p)
+            codes = run(chain, np.concatenate([x[rows], mean[rows]], axis=1))
+            x = _spread(codes, rows, k, z, with_state=k > p)
         pooled = x[own].max(axis=1)
         if self.columns:
             taken = np.zeros((p, max(self.columns) + 1), np.float32) if features is None else features
@@ -235,7 +239,7 @@ def _spread(codes: np.ndarray, rows: tuple[np.ndarray, ...], k: int, z: int, wit
     return x
 
 
-def first_activation(x: np.ndarray, layer: Affine) -> np.ndarray:
+def _activate(x: np.ndarray, layer: Affine) -> np.ndarray:
     """The activation of a layer whose affine part was computed in pieces."""
     if layer.activation:
         np.maximum(x, SLOPE * x, out=x)

@@ -28,6 +28,7 @@ import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State, zone_samples
+from zonegraph.plugins import model_problem
 from zonegraph.sequence.features import proposal_features, target_surfaces
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.sequence.rankers import HeuristicRanker
@@ -71,7 +72,7 @@ class NumpyScorer:
         self.search = folded.search
         self._graph: ZoneGraph | None = None
         self._state: State | None = None
-        self._codes: np.ndarray | None = None
+        self._geometry: np.ndarray | None = None
 
     def score(
         self,
@@ -86,9 +87,9 @@ class NumpyScorer:
                 self._graph = graph
                 self._state = State.of(graph.zone_inside, canvas, graph.edges.astype(np.int64))
                 points = zone_samples(graph, self.points_per_zone) if self.folded.points else None
-                self._codes = None if points is None else self.folded.encode_geometry(points)
+                self._geometry = None if points is None else self.folded.encode_geometry(points)
             state = self._state.with_canvas(canvas)
-            return self.folded.score(state, zones, ops.astype(np.float32), self._codes, features)
+            return self.folded.score(state, zones, ops.astype(np.float32), self._geometry, features)
 
 
 @cache
@@ -102,14 +103,12 @@ def open_scorer(path: Path, device: str = "cpu") -> StateScorer:
     on the CPU), PyTorch otherwise (which then must be installed)."""
     if path.suffix == ".npz":
         return NumpyScorer(FoldedScorer.load(path))
-    try:
-        from zonegraph.network.checkpoint import fold_checkpoint, read_checkpoint
-        from zonegraph.network.scoring import TorchScorer
-    except ImportError as exc:
-        raise ValueError(
-            f"{path}: a PyTorch checkpoint needs torch and torch_geometric (pip install 'zonegraph[train]'), "
-            "or its numpy export (python -m training.fold)"
-        ) from exc
+    problem = model_problem(str(path))
+    if problem is not None:
+        raise ValueError(problem)
+    from zonegraph.network.checkpoint import fold_checkpoint, read_checkpoint
+    from zonegraph.network.scoring import TorchScorer
+
     checkpoint = read_checkpoint(path, device)
     if checkpoint["model"].get("fusion", "late") == "late" and device == "cpu":
         return NumpyScorer(fold_checkpoint(checkpoint))
@@ -124,7 +123,7 @@ class NetworkRanker:
     def __init__(
         self,
         model: str | Path | None = None,
-        seed: int = 0,
+        seed: int = 0,  # the guides' factory signature; the forward draws nothing
         device: str = "cpu",
         top_m: int | None = None,
         blend: float | None = None,
@@ -132,7 +131,6 @@ class NetworkRanker:
         path = Path(model) if model else SHIPPED_FOLDED
         if not path.is_file():
             raise ValueError(f"{path}: no model checkpoint (in a checkout: python -m training.train)")
-        self.seed = seed  # the forward is deterministic; kept for the Ranker factories' signature
         self.scorer = open_scorer(path, device)
         self.samples = int(self.scorer.points_per_zone or self.samples)
         search = self.scorer.search

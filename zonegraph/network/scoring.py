@@ -15,7 +15,7 @@ import torch
 from torch import Tensor
 from torch_geometric.data import Batch
 
-from zonegraph.network.checkpoint import scorer_from
+from zonegraph.network.checkpoint import guide_settings, scorer_from
 from zonegraph.network.encoding import Geometry, geometry_of, state_data
 from zonegraph.network.model import ProposalScorer
 from zonegraph.zones.model import ZoneGraph
@@ -68,9 +68,7 @@ class TorchScorer:
         self.device = torch.device(device)
         self.model = scorer_from(checkpoint, device)
         self.columns = tuple(self.model.columns)
-        samples = checkpoint["train"].get("points_per_zone")
-        self.points_per_zone = None if samples is None else int(samples)
-        self.search: dict[str, Any] = dict(checkpoint.get("search", {}))
+        self.points_per_zone, self.search = guide_settings(checkpoint)
         self._graph: ZoneGraph | None = None
         self._geometry: Geometry | None = None
         self._codes: Tensor | None = None
