@@ -10,9 +10,11 @@ and combined, ranked on held-out designs.
 A variant is a ``+``-joined list of changes to the ``train`` section of the params (the ``base``):
 ``focal`` / ``listwise`` (the objective), ``features`` / ``no_features`` (every proposal feature of
 :data:`~zonegraph.sequence.features.FEATURES`, or none), ``late`` / ``early`` (the fusion),
-``points`` / ``no_points`` (the zones' point geometry) and ``roundsN``; e.g.
-``listwise+features+early``. Without ``--variants`` the runner trains the base, every change
-alone, and the objective and features together with each of the others. Each variant is one
+``points`` / ``no_points`` (the zones' point geometry), ``roundsN``, ``hiddenN`` (the width of
+every layer) and ``teacher`` (the listwise target shared with ``--teacher``'s scores: a student
+distilled from a trained checkpoint); e.g. ``listwise+features+early`` or
+``listwise+features+no_points+hidden48+teacher``. Without ``--variants`` the runner trains the
+base, every change alone, and the objective and features together with each of the others. Each variant is one
 training run of ``training.train`` (MLflow experiment ``ablations``) on a seeded sample of
 ``--designs`` training designs, so variants compare at equal data; a finished variant (its
 checkpoint and its config) is reused, so an interrupted ablation resumes. Every variant, random,
@@ -52,21 +54,30 @@ CHANGES: dict[str, dict[str, Any]] = {  # a variant's tokens, as overrides of th
 }
 
 
-def variant(base: TrainConfig, spec: str) -> TrainConfig:
-    """The base with the changes of ``spec`` (``base``, or tokens of :data:`CHANGES` and
-    ``roundsN`` joined by ``+``); an unknown token exits with one line."""
+def variant(base: TrainConfig, spec: str, teacher: str | None = None) -> TrainConfig:
+    """The base with the changes of ``spec`` (``base``, or tokens of :data:`CHANGES`, ``roundsN``,
+    ``hiddenN`` and ``teacher`` joined by ``+``); an unknown token exits with one line."""
     config = base
     for token in spec.split("+"):
         if token == "base":
             continue
-        rounds = re.fullmatch(r"rounds(\d+)", token)
+        rounds, hidden = re.fullmatch(r"rounds(\d+)", token), re.fullmatch(r"hidden(\d+)", token)
         if rounds:
             config = replace(config, rounds=int(rounds.group(1)))
+        elif hidden:
+            config = replace(config, hidden=int(hidden.group(1)))
+        elif token == "teacher":
+            if teacher is None:
+                raise SystemExit(
+                    f"ablations: {spec!r} learns from a teacher: name its checkpoint with --teacher"
+                )
+            config = replace(config, teacher=teacher)
         elif token in CHANGES:
             config = replace(config, **CHANGES[token])
         else:
             raise SystemExit(
-                f"ablations: unknown change {token!r} in {spec!r} (one of {', '.join(CHANGES)}, roundsN)"
+                f"ablations: unknown change {token!r} in {spec!r} "
+                f"(one of {', '.join(CHANGES)}, roundsN, hiddenN, teacher)"
             )
     return config
 
@@ -120,7 +131,11 @@ def same_settings(stamp: str, wanted: str) -> bool:
 def describe(config: TrainConfig) -> str:
     features = f"{len(config.features)} features" if config.features else "no features"
     points = "points" if config.use_points else "no points"
-    return f"{config.loss}, {features}, {config.fusion} fusion, {points}, {config.rounds} rounds"
+    taught = f", {config.distill:g} taught by {Path(config.teacher).name}" if config.teacher else ""
+    return (
+        f"{config.loss}, {features}, {config.fusion} fusion, {points}, {config.rounds} rounds, "
+        f"hidden {config.hidden}{taught}"
+    )
 
 
 def trained(name: str, folder: Path) -> dict[str, Any]:
@@ -156,6 +171,7 @@ def main() -> None:
     parser.add_argument("--epochs", type=int, default=3)
     parser.add_argument("--eval-designs", type=int, default=100)
     parser.add_argument("--compare", nargs="*", default=[], help="other checkpoints ranked beside them")
+    parser.add_argument("--teacher", default=None, help="the checkpoint a `teacher` variant learns from")
     parser.add_argument("--labels", default=None, help="the labels folder (default: params)")
     parser.add_argument("--graphs", default=None, help="the zone graphs folder (default: params)")
     parser.add_argument(
@@ -173,7 +189,7 @@ def main() -> None:
     base = replace(base, **{k: v for k, v in (("labels_dir", args.labels), ("graphs_dir", args.graphs)) if v})
     args.out.mkdir(parents=True, exist_ok=True)
     specs = args.variants or default_specs(base, args.rounds)
-    chosen = {spec: variant(base, spec) for spec in specs}
+    chosen = {spec: variant(base, spec, args.teacher) for spec in specs}
     models = [train_variant(name, config, args.out) for name, config in chosen.items()]
     compared = [Path(c) for c in args.compare]
     seen, _ = trained_projects([*models, *compared])

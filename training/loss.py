@@ -6,6 +6,11 @@ loss is a softmax of those log-odds over each state's proposals, so either objec
 one score the search sorts by. The focal loss judges each proposal alone, while the metric the
 guide is judged by (where the GT lands among a state's proposals) is a property of the whole
 list; the listwise loss trains that directly.
+
+A trained scorer can also teach another (knowledge distillation, Hinton et al. 2015): the listwise
+target of a state then mixes the GT with the teacher's softmax over the same proposals
+(:func:`distilled_weight`), so a narrower student, cheaper in search, learns the teacher's whole
+ordering and not only its first place, from fewer designs than the teacher saw.
 """
 
 from __future__ import annotations
@@ -15,6 +20,35 @@ from torch import Tensor
 from torch_geometric.utils import scatter
 
 LOSSES = ("focal", "listwise")
+
+
+def state_softmax(score: Tensor, state: Tensor) -> Tensor:
+    """Each proposal's share of its state's softmax over ``score``.
+
+    Shapes:
+        score: (P,); state: (P,) int64, the state of each proposal (0..S-1); returns (P,).
+    """
+    states = int(state.max()) + 1 if len(state) else 0
+    top = scatter(score, state, dim=0, dim_size=states, reduce="max")
+    exp = (score - top[state]).exp()
+    return exp / scatter(exp, state, dim=0, dim_size=states, reduce="sum")[state]
+
+
+def distilled_weight(
+    weight: Tensor, teacher: Tensor, state: Tensor, share: float, temperature: float
+) -> Tensor:
+    """A listwise target that gives the teacher ``share`` of each state: ``(1 - share)`` times the
+    GT's normalised ``weight`` plus ``share`` times the teacher's softmax of its log-odds at
+    ``temperature`` (above 1 it shows more of the teacher's order below its first choice).
+
+    Shapes:
+        weight: (P,) >= 0; teacher: (P, 2) the teacher's logits; state: (P,) int64; returns (P,).
+    """
+    states = int(state.max()) + 1 if len(state) else 0
+    total = scatter(weight, state, dim=0, dim_size=states, reduce="sum")
+    truth = weight / total[state].clamp_min(1e-12)
+    taught = state_softmax((teacher[:, 1] - teacher[:, 0]) / temperature, state)
+    return (1.0 - share) * truth + share * taught
 
 
 def focal_loss(logits: Tensor, target: Tensor, gamma: float = 0.5) -> Tensor:

@@ -45,11 +45,12 @@ import torch
 from torch_geometric.loader import DataLoader
 
 from training.data import LabelDataset
-from training.loss import LOSSES, focal_loss, listwise_loss
+from training.loss import LOSSES, distilled_weight, focal_loss, listwise_loss
 from training.shards import label_shards
 from zonegraph.configs import Config, ConfigError, load_section
 from zonegraph.data.dataset import project_of, test_ids
-from zonegraph.network.model import ModelConfig, ProposalScorer
+from zonegraph.network.checkpoint import read_checkpoint, scorer_from
+from zonegraph.network.model import HIDDEN, ModelConfig, ProposalScorer
 from zonegraph.network.scoring import score_state
 from zonegraph.sequence.rankers import GTPlace, gt_place
 
@@ -73,9 +74,13 @@ class TrainConfig(Config):
     fusion: str = "late"
     rounds: int = 3
     use_points: bool = True
+    hidden: int = HIDDEN  # width of every layer: a search pays for it at every state
     features: tuple[str, ...] = ()  # proposal features the scorer reads (zonegraph.sequence.features)
     loss: str = "focal"  # focal (per proposal) or listwise (softmax over a state's proposals)
     neutral_credit: float | None = None  # listwise: None leaves neutrals out, else their target weight
+    teacher: str | None = None  # listwise: a trained checkpoint whose scores share the target
+    distill: float = 0.5  # the teacher's share of each state's target (with a teacher)
+    temperature: float = 2.0  # of the teacher's softmax
     epochs: int = 3
     lr: float = 1e-3
     batch_states: int = 8  # states per batch (each with up to max_proposals proposals)
@@ -91,7 +96,11 @@ class TrainConfig(Config):
     @property
     def model(self) -> ModelConfig:
         return ModelConfig(
-            fusion=self.fusion, rounds=self.rounds, use_points=self.use_points, features=self.features
+            fusion=self.fusion,
+            rounds=self.rounds,
+            use_points=self.use_points,
+            hidden=self.hidden,
+            features=self.features,
         )
 
     def check(self) -> None:
@@ -104,6 +113,10 @@ class TrainConfig(Config):
             self.model.feature_columns()
         except ValueError as exc:
             raise SystemExit(f"train: {exc}") from None
+        if self.teacher is not None and (self.loss != "listwise" or not 0.0 <= self.distill <= 1.0):
+            raise SystemExit("train: a teacher shares the listwise target: loss listwise, distill in [0, 1]")
+        if self.teacher is not None and not Path(self.teacher).is_file():
+            raise SystemExit(f"train: {self.teacher}: no teacher checkpoint")
         if self.device == "cuda" and not torch.cuda.is_available():
             raise SystemExit("train: --device cuda, but torch finds no CUDA device (use cpu or auto)")
 
@@ -119,25 +132,49 @@ def forward(model: ProposalScorer, batch: Any) -> torch.Tensor:
     return model(batch)
 
 
-def objective(config: TrainConfig, logits: torch.Tensor, batch: Any) -> torch.Tensor:
-    """The configured loss of one batch."""
+def objective(
+    config: TrainConfig, logits: torch.Tensor, batch: Any, teacher: ProposalScorer | None = None
+) -> torch.Tensor:
+    """The configured loss of one batch (with a teacher, its scores share the listwise target)."""
     if config.loss == "focal":
         keep = batch.label != 0  # neutrals kept for a listwise loss carry no focal signal
         return focal_loss(logits[keep], batch.y[keep], config.gamma)
     weight = (batch.label == 1).float()
     if config.neutral_credit:
         weight = weight + config.neutral_credit * (batch.label == 0).float()
+    if teacher is not None:
+        with torch.no_grad():
+            taught = forward(teacher, batch)
+        weight = distilled_weight(weight, taught, batch.state, config.distill, config.temperature)
     return listwise_loss(logits, batch.state, weight)
 
 
-def mean_loss(model: ProposalScorer, loader: DataLoader, device: torch.device, config: TrainConfig) -> float:
+def load_teacher(config: TrainConfig, device: torch.device) -> tuple[ProposalScorer | None, list[str]]:
+    """The teacher in eval mode and the projects it trained on (a student has seen them too:
+    evaluation leaves them out), or None and no projects."""
+    if config.teacher is None:
+        return None, []
+    checkpoint = read_checkpoint(config.teacher, str(device))
+    teacher = scorer_from(checkpoint, str(device))
+    if teacher.config.use_points and not config.use_points:
+        raise SystemExit(f"train: {config.teacher}: the teacher reads point geometry; train with use_points")
+    return teacher, list(checkpoint.get("provenance", {}).get("train_projects", []))
+
+
+def mean_loss(
+    model: ProposalScorer,
+    loader: DataLoader,
+    device: torch.device,
+    config: TrainConfig,
+    teacher: ProposalScorer | None = None,
+) -> float:
     model.eval()
     total, count = 0.0, 0
     with torch.no_grad():
         for batch in loader:
             batch = batch.to(device)
             logits = forward(model, batch)
-            total += float(objective(config, logits, batch)) * len(batch.y)
+            total += float(objective(config, logits, batch, teacher)) * len(batch.y)
             count += len(batch.y)
     return total / max(count, 1)
 
@@ -198,7 +235,9 @@ def metric_name(key: str) -> str:
 def run_name(config: TrainConfig, train_designs: int) -> str:
     """What the dashboard lists: the fusion, the objective, the data and the seed."""
     features = " +features" if config.features else ""
-    return f"{config.fusion} {config.loss}{features} {train_designs} designs seed{config.seed}"
+    width = f" hidden{config.hidden}" if config.hidden != HIDDEN else ""
+    taught = f" +teacher{config.distill:g}" if config.teacher else ""
+    return f"{config.fusion} {config.loss}{features}{width}{taught} {train_designs} designs seed{config.seed}"
 
 
 def log_labels(labels_dir: str | Path, version: str) -> None:
@@ -351,6 +390,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     )
     val_loader = DataLoader(sets["val"], batch_size=config.batch_states)
     model = ProposalScorer(config.model).to(device)
+    teacher, taught = load_teacher(config, device)
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
     out = Path(config.out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -388,7 +428,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
         else:
             resumed = {f"resumed_at_epoch_{first}": str(device), "git_commit_resumed": tags["git_commit"]}
             mlflow.set_tags(resumed)
-        seen = sorted({project_of(d) for d in [*train_ids, *val_ids]})  # evaluation must skip these
+        seen = sorted({project_of(d) for d in [*train_ids, *val_ids]} | set(taught))  # evaluation skips these
         provenance = {**sizes, **tags, "run_id": run.info.run_id, "train_projects": seen}
         for epoch in range(first, config.epochs + 1):
             t0 = time.perf_counter()
@@ -398,7 +438,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
                 batch = batch.to(device)
                 if len(batch.y) < 2:  # BatchNorm needs two examples
                     continue
-                loss = objective(config, forward(model, batch), batch)
+                loss = objective(config, forward(model, batch), batch, teacher)
                 optimiser.zero_grad()
                 loss.backward()
                 optimiser.step()
@@ -407,7 +447,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
             row = {
                 "epoch": epoch,
                 "train_loss": float(np.mean(losses)) if losses else float("nan"),
-                "val_loss": mean_loss(model, val_loader, device, config),
+                "val_loss": mean_loss(model, val_loader, device, config, teacher),
                 **rank_metrics(places),
                 "seconds": time.perf_counter() - t0,
             }

@@ -271,6 +271,10 @@ def test_an_ablation_variant_is_the_base_with_its_changes_each_alone_and_combine
     assert "listwise+features+early" in specs and "rounds3" not in specs
     with pytest.raises(SystemExit, match="unknown change 'deep'"):
         variant(base, "listwise+deep")
+    student = variant(base, "listwise+hidden48+teacher", teacher="teacher.pt")
+    assert (student.hidden, student.teacher, student.model.hidden) == (48, "teacher.pt", 48)
+    with pytest.raises(SystemExit, match="--teacher"):
+        variant(base, "listwise+teacher")
 
 
 def test_listwise_loss_is_a_softmax_over_each_state_with_the_gt_as_target():
@@ -290,6 +294,56 @@ def test_listwise_loss_is_a_softmax_over_each_state_with_the_gt_as_target():
     assert (
         listwise_loss(logits, state, torch.tensor([0.0, 0, 0, 0, 1])) == -torch.log_softmax(score[3:], 0)[1]
     )
+
+
+def test_a_distilled_target_mixes_the_gt_with_the_teachers_softmax_per_state():
+    from training.loss import distilled_weight, listwise_loss
+
+    state = torch.tensor([0, 0, 0, 1, 1])
+    teacher = torch.tensor([[0.0, 2.0], [0.0, 0.0], [0.0, 1.0], [0.0, 3.0], [0.0, 1.0]])
+    gt = torch.tensor([0.0, 1, 0, 0, 0])  # the second state has no GT among its proposals
+    target = distilled_weight(gt, teacher, state, 0.25, 2.0)
+    taught = torch.cat(
+        [torch.softmax(torch.tensor([2.0, 0, 1]) / 2, 0), torch.softmax(torch.tensor([3.0, 1]) / 2, 0)]
+    )
+    assert torch.allclose(target, 0.75 * torch.tensor([0.0, 1, 0, 0, 0]) + 0.25 * taught)
+    assert torch.allclose(distilled_weight(gt, teacher, state, 0.0, 2.0), torch.tensor([0.0, 1, 0, 0, 0]))
+    logits = torch.zeros(5, 2, requires_grad=True)
+    listwise_loss(logits, state, target).backward()
+    assert logits.grad[3, 1] < 0 < logits.grad[4, 1]  # a state without a GT learns the teacher's order
+
+
+@requires_samples
+def test_a_narrow_student_learns_from_a_teacher_folds_and_owns_its_projects(labelled, tmp_path, monkeypatch):
+    from zonegraph.network.checkpoint import fold_checkpoint, read_checkpoint
+    from zonegraph.sequence.features import FEATURES
+
+    monkeypatch.chdir(tmp_path)
+    common = dict(
+        labels_dir=str(labelled / "labels"),
+        graphs_dir=str(labelled / "graphs"),
+        epochs=1,
+        val_fraction=0.34,
+        points_per_zone=16,
+        batch_states=4,
+        loss="listwise",
+        features=FEATURES,
+        use_points=False,
+    )
+    train(TrainConfig(**common, out_dir="teacher"))
+    teacher = read_checkpoint(tmp_path / "teacher" / "scorer.pt")
+    teacher["provenance"]["train_projects"].append("elsewhere")  # a project only the teacher saw
+    torch.save(teacher, tmp_path / "teacher" / "scorer.pt")
+    train(
+        TrainConfig(**common, out_dir="student", hidden=16, teacher=str(tmp_path / "teacher" / "scorer.pt"))
+    )
+    student = read_checkpoint(tmp_path / "student" / "scorer.pt")
+    assert student["model"]["hidden"] == 16 and student["train"]["teacher"].endswith("teacher/scorer.pt")
+    assert "elsewhere" in student["provenance"]["train_projects"]
+    folded = fold_checkpoint(student)
+    assert folded.rounds[0][0].weight.shape == (32, 16)
+    with pytest.raises(SystemExit, match="loss listwise"):
+        TrainConfig(**{**common, "loss": "focal"}, teacher=str(tmp_path / "teacher" / "scorer.pt")).check()
 
 
 @requires_samples
