@@ -1,7 +1,7 @@
 """What the network guide costs in search: exact rate and time to exact, heuristic vs network.
 
     python -m bench.guide_cost_bench --graphs data/zonegraphs/graphs --gt data/gt
-        [--guides heuristic net=CHECKPOINT net=CHECKPOINT@top_m=8,blend=0.5 ...]
+        [--guides heuristic net=CHECKPOINT net=CHECKPOINT@top_m=8,blend=0.5,margin=0.1 ...]
         [--designs 20] [--budgets 1 5] [--seed 7] [--out bench_out/guide_cost]
 
 Searches the saved (simplified) zone graph of a seeded sample of test designs, stratified by
@@ -20,53 +20,18 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from eval.guides import GuideSpec
 from eval.heldout import held_out, trained_projects
 from zonegraph.data.dataset import stratified_sample
-from zonegraph.network.ranker import NetworkRanker
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.proposals import ProposalGenerator
-from zonegraph.sequence.rankers import Ranker, make_ranker
 from zonegraph.zones.storage import load_zone_graph
-
-
-@dataclass(frozen=True)
-class GuideSpec:
-    """One guide of the comparison: ``heuristic``, ``random`` or ``net=PATH@top_m=M,blend=B``."""
-
-    label: str
-    name: str
-    model: str | None = None
-    top_m: int | None = None
-    blend: float | None = None
-
-    @classmethod
-    def parse(cls, spec: str) -> GuideSpec:
-        name, _, rest = spec.partition("=")
-        if name != "net":
-            return cls(spec, spec)
-        model, _, knobs = rest.partition("@")
-        options = dict(kv.split("=", 1) for kv in knobs.split(",") if kv)
-        unknown = set(options) - {"top_m", "blend"}
-        if unknown:
-            raise SystemExit(f"guide_cost_bench: {spec}: unknown option {sorted(unknown)} (top_m, blend)")
-        top_m = int(options["top_m"]) if "top_m" in options else None
-        blend = float(options["blend"]) if "blend" in options else None
-        shipped = Path(model).name == "scorer.pt" and Path(model).parent.name == "checkpoints"
-        name = "shipped" if shipped else Path(model).parent.name or model
-        label = f"net:{name}" + (f"@{knobs}" if knobs else "")
-        return cls(label, "net", model or None, top_m, blend)
-
-    def ranker(self, seed: int) -> Ranker:
-        if self.name != "net":
-            return make_ranker(self.name, seed)
-        return NetworkRanker(self.model, seed, top_m=self.top_m, blend=self.blend)
 
 
 def chosen_designs(gt: Path, graphs: Path, models: list[str], count: int, seed: int) -> pd.DataFrame:

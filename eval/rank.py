@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 import pyarrow.dataset as ds
 
+from eval.guides import GuideSpec
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.sequence.rankers import GTPlace, Ranker, gt_place, make_ranker, score_step
 from zonegraph.zones.model import ZoneGraph
@@ -150,12 +151,15 @@ def guide_ranks(
 
 
 def make_guides(names: Sequence[str], models: Sequence[str | Path] = (), seed: int = 0) -> dict[str, Ranker]:
-    """Rankers by guide name, plus one network guide per model checkpoint (named by its file)."""
+    """Rankers by guide name, plus one network guide per model checkpoint (named by its file),
+    which may carry the guide's knobs: ``PATH@top_m=8,blend=0.3`` (:mod:`eval.guides`)."""
     guides = {name: make_ranker(name, seed) for name in names}
     for model in models:
-        path = Path(model)
+        spec = GuideSpec.parse(f"net={model}")
+        path = Path(spec.model or "")
         label = path.stem if path.stem != "scorer" else f"net:{path.parent.name or path.stem}"
-        guides[label] = make_ranker("net", seed, str(path))
+        knobs = str(model).partition("@")[2]
+        guides[label + (f"@{knobs}" if knobs else "")] = spec.ranker(seed)
     return guides
 
 

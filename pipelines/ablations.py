@@ -170,7 +170,9 @@ def main() -> None:
     parser.add_argument("--designs", type=int, default=300, help="training designs per variant (0: all)")
     parser.add_argument("--epochs", type=int, default=3)
     parser.add_argument("--eval-designs", type=int, default=100)
-    parser.add_argument("--compare", nargs="*", default=[], help="other checkpoints ranked beside them")
+    parser.add_argument(
+        "--compare", nargs="*", default=[], help="other checkpoints ranked beside them: PATH[@knob=value,...]"
+    )
     parser.add_argument("--teacher", default=None, help="the checkpoint a `teacher` variant learns from")
     parser.add_argument("--labels", default=None, help="the labels folder (default: params)")
     parser.add_argument("--graphs", default=None, help="the zone graphs folder (default: params)")
@@ -191,8 +193,8 @@ def main() -> None:
     specs = args.variants or default_specs(base, args.rounds)
     chosen = {spec: variant(base, spec, args.teacher) for spec in specs}
     models = [train_variant(name, config, args.out) for name, config in chosen.items()]
-    compared = [Path(c) for c in args.compare]
-    seen, _ = trained_projects([*models, *compared])
+    compared = list(args.compare)  # checkpoints, each may carry the guide's knobs (PATH@top_m=8)
+    seen, _ = trained_projects([*models, *(c.partition("@")[0] for c in compared)])
     labels, graphs = args.eval_labels or base.labels_dir, args.eval_graphs or base.graphs_dir
     designs = held_out_labelled(labels, "test", seen)[: args.eval_designs]
     guides = make_guides(["random", "heuristic"], [*models, *compared], base.seed)

@@ -1,0 +1,31 @@
+"""Guides named on a command line, with a network's knobs."""
+
+from __future__ import annotations
+
+import pytest
+
+from eval.guides import GuideSpec
+from eval.rank import make_guides
+from zonegraph.network.folded import SHIPPED_FOLDED
+from zonegraph.network.ranker import NetworkRanker
+from zonegraph.sequence.rankers import HeuristicRanker
+
+
+def test_a_network_spec_carries_its_knobs_to_the_ranker():
+    spec = GuideSpec.parse(f"net={SHIPPED_FOLDED}@top_m=4,blend=0.25")
+    assert (spec.name, spec.model, dict(spec.knobs)) == (
+        "net",
+        str(SHIPPED_FOLDED),
+        {"top_m": 4, "blend": 0.25},
+    )
+    ranker = spec.ranker(0)
+    assert isinstance(ranker, NetworkRanker) and (ranker.top_m, ranker.blend) == (4, 0.25)
+    assert GuideSpec.parse("heuristic") == GuideSpec("heuristic", "heuristic")
+    with pytest.raises(SystemExit, match="unknown option"):
+        GuideSpec.parse("net=x.pt@depth=3")
+
+
+def test_rank_guides_take_network_specs_beside_plain_checkpoints():
+    guides = make_guides(["heuristic"], [str(SHIPPED_FOLDED), f"{SHIPPED_FOLDED}@top_m=2"])
+    assert isinstance(guides["heuristic"], HeuristicRanker)
+    assert guides["net:checkpoints"].top_m == 8 and guides["net:checkpoints@top_m=2"].top_m == 2
