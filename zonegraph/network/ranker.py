@@ -9,11 +9,13 @@ PyTorch checkpoint of late fusion is folded when loaded. Early and factored fusi
 Either way a graph's zone geometry is encoded once and each state's proposals are scored in one
 batched pass, in eval mode.
 
-Scoring counts inside the search's budget, so three knobs trade the network's cost against the
+Scoring counts inside the search's budget, so knobs trade the network's cost against the
 heuristic's: ``top_m`` scores only the heuristic's best M proposals of a state with the network
-(the rest follow, in the heuristic's order, below every scored one), and ``blend`` mixes the
-heuristic's score into the network's (``(1 - blend) * net + blend * heuristic``). A checkpoint
-may carry its own defaults for both (its ``search`` entry); the arguments override them. And a
+(the rest follow, in the heuristic's order, below every scored one), ``margin`` only those whose
+heuristic score is within that much of the best one's (a state where the heuristic's first
+choice leads by more costs no network call at all), and ``blend`` mixes the heuristic's score
+into the network's (``(1 - blend) * net + blend * heuristic``). A checkpoint may carry its own
+defaults (its ``search`` entry); the arguments override them. And a
 proposal that completes the target (its canvas after the step agrees with the target on every
 zone) goes first unscored: it ends the search, whatever a scorer would say of it.
 """
@@ -127,6 +129,7 @@ class NetworkRanker:
         device: str = "cpu",
         top_m: int | None = None,
         blend: float | None = None,
+        margin: float | None = None,
     ) -> None:
         path = Path(model) if model else SHIPPED_FOLDED
         if not path.is_file():
@@ -136,6 +139,7 @@ class NetworkRanker:
         search = self.scorer.search
         self.top_m: int | None = top_m if top_m is not None else search.get("top_m")
         self.blend = float(blend if blend is not None else search.get("blend", 0.0))
+        self.margin: float | None = margin if margin is not None else search.get("margin")
         self._heuristic = HeuristicRanker()
         self._graph: ZoneGraph | None = None
         self._on_target: np.ndarray | None = None
@@ -148,8 +152,8 @@ class NetworkRanker:
         self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int
     ) -> np.ndarray:
         """(P,) scores of every proposal of one state ``step`` operations deep: P(positive), or
-        its blend with the heuristic; proposals outside the heuristic's top M below them all, a
-        proposal that completes the target above them all."""
+        its blend with the heuristic; proposals outside the heuristic's top M or its margin below
+        them all, a proposal that completes the target above them all."""
         if not proposals:
             return np.zeros(0)
         heuristic = self._heuristic.score(graph, canvas, proposals)
@@ -157,8 +161,12 @@ class NetworkRanker:
         if complete.any():
             return np.where(complete, COMPLETES + heuristic, UNSCORED + heuristic)
         chosen = np.arange(len(proposals))
-        if self.top_m and self.top_m < len(proposals):
-            chosen = np.sort(np.argsort(-heuristic, kind="stable")[: self.top_m])
+        if self.margin is not None:
+            chosen = np.flatnonzero(heuristic >= heuristic.max() - self.margin)
+        if self.top_m and self.top_m < len(chosen):
+            chosen = np.sort(chosen[np.argsort(-heuristic[chosen], kind="stable")[: self.top_m]])
+        if len(chosen) == 1:  # the heuristic's first choice, alone in reach: its order stands
+            return heuristic
         picked = [proposals[i] for i in chosen]
         zones = np.stack([p.zones for p in picked]).astype(bool)
         ops = np.array([1 if p.op is Op.UNION else -1 for p in picked])
