@@ -27,22 +27,32 @@ import numpy as np
 import pandas as pd
 
 from eval.guides import GuideSpec
-from eval.heldout import held_out, trained_projects
+from eval.heldout import PARTS, held_out, part_of, trained_projects
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.zones.storage import load_zone_graph
 
 
-def chosen_designs(gt: Path, graphs: Path, models: list[str], count: int, seed: int) -> pd.DataFrame:
+def chosen_designs(
+    gt: Path,
+    graphs: Path,
+    models: list[str],
+    count: int,
+    seed: int,
+    part: str | None = None,
+    part_seed: int = 0,
+) -> pd.DataFrame:
     """A seeded sample of ``count`` test designs with a saved graph, stratified by folder, none of a
-    project the checkpoints trained on; with their GT step counts."""
+    project the checkpoints trained on (and of one half of them by project, with ``part``); with
+    their GT step counts."""
     designs = pd.read_parquet(gt / "designs.parquet")
     designs = designs[
         (designs["split"] == "test") & designs["design_id"].map(lambda d: (graphs / d).is_dir())
     ]
     seen, _ = trained_projects(models) if models else (set(), [])
-    designs = designs[designs["design_id"].isin(held_out(designs["design_id"], seen))]
+    kept = part_of(held_out(designs["design_id"], seen), part, part_seed)
+    designs = designs[designs["design_id"].isin(kept)]
     designs = designs.sort_values("design_id").reset_index(drop=True)
     return designs.iloc[stratified_sample(designs["folder"].astype(str).tolist(), count, seed)]
 
@@ -115,11 +125,13 @@ def main() -> None:
     parser.add_argument("--designs", type=int, default=20)
     parser.add_argument("--budgets", type=float, nargs="+", default=[1.0, 5.0])
     parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--part", choices=PARTS, default=None, help="one half of the designs by project")
+    parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
     parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))
     args = parser.parse_args()
     guides = [GuideSpec.parse(g) for g in args.guides]
-    models = [g.model for g in guides if g.model]
-    designs = chosen_designs(args.gt, args.graphs, models, args.designs, args.seed)
+    models = [g.model for g in guides if g.model]  # a .npz carries no provenance: name the .pt
+    designs = chosen_designs(args.gt, args.graphs, models, args.designs, args.seed, args.part, args.part_seed)
     print(
         f"guide_cost_bench: {len(designs)} designs: {designs['folder'].value_counts().sort_index().to_dict()}"
     )

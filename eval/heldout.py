@@ -12,24 +12,37 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+import numpy as np
 import pyarrow.dataset as ds
 
 from zonegraph.data.dataset import project_of
 
+PARTS = ("tune", "report")
+
 
 def trained_projects(models: Sequence[str | Path]) -> tuple[set[str], list[str]]:
-    """The projects any of ``models`` saw in training, and the models that do not say."""
-    import torch  # only when a model is evaluated
-
+    """The projects any of ``models`` (PyTorch checkpoints or their numpy folds) saw in training,
+    and the models that do not say."""
     seen: set[str] = set()
     silent = []
     for model in models:
-        provenance = torch.load(model, map_location="cpu", weights_only=True).get("provenance", {})
-        if "train_projects" in provenance:
-            seen.update(provenance["train_projects"])
-        else:
+        projects = _projects(Path(model))
+        if projects is None:
             silent.append(str(model))
+        else:
+            seen.update(projects)
     return seen, silent
+
+
+def _projects(model: Path) -> list[str] | None:
+    if model.suffix == ".npz":
+        from zonegraph.network.folded import FoldedScorer
+
+        return list(FoldedScorer.load(model).train_projects) or None
+    import torch  # only when a PyTorch model is evaluated
+
+    provenance = torch.load(model, map_location="cpu", weights_only=True).get("provenance", {})
+    return provenance.get("train_projects")
 
 
 def held_out(design_ids: Iterable[str], projects: set[str]) -> list[str]:
@@ -42,3 +55,17 @@ def held_out_labelled(labels_dir: str | Path, split: str, projects: set[str]) ->
     steps = ds.dataset(Path(labels_dir) / "steps", format="parquet").to_table(columns=["design_id", "split"])
     ids = steps.filter(ds.field("split") == split).column("design_id").to_pylist()
     return held_out(sorted(set(ids)), projects)
+
+
+def part_of(design_ids: Sequence[str], part: str | None, seed: int) -> list[str]:
+    """One of two halves of ``design_ids`` by project, drawn with ``seed``, in their order: knobs
+    of a guide are chosen on ``tune`` and reported on ``report``, so the figure is of designs
+    that did not steer the choice. ``None``: all of them."""
+    if part is None:
+        return list(design_ids)
+    if part not in PARTS:
+        raise ValueError(f"unknown part {part!r} (one of {', '.join(PARTS)})")
+    projects = sorted({project_of(d) for d in design_ids})
+    order = np.random.default_rng(seed).permutation(len(projects))
+    tune = {projects[i] for i in order[: len(projects) // 2]}
+    return [d for d in design_ids if (project_of(d) in tune) == (part == "tune")]

@@ -26,6 +26,7 @@ import pandas as pd
 import pyarrow.dataset as ds
 
 from eval.guides import GuideSpec
+from eval.heldout import PARTS, held_out_labelled, part_of, trained_projects
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.sequence.rankers import GTPlace, Ranker, gt_place, make_ranker, score_step
 from zonegraph.zones.model import ZoneGraph
@@ -339,13 +340,17 @@ def main() -> None:
     parser.add_argument("--guides", nargs="*", default=["random", "heuristic"])
     parser.add_argument("--model", nargs="*", default=[], help="network checkpoints to rank with")
     parser.add_argument("--limit", type=int, default=None, help="the first N designs (by id) only")
+    parser.add_argument(
+        "--part", choices=PARTS, default=None, help="one half of the designs by project (default: all)"
+    )
+    parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, default=Path("eval_out/rank"))
     args = parser.parse_args()
-    designs = None
-    if args.limit is not None:
-        steps = _read(args.labels, "steps", args.split, None)
-        designs = sorted(set(steps["design_id"]))[: args.limit]
+    seen, _ = trained_projects([GuideSpec.parse(f"net={m}").model or "" for m in args.model])
+    designs = part_of(held_out_labelled(args.labels, args.split, seen), args.part, args.part_seed)
+    designs = designs[: args.limit]
+    print(f"rank: {len(designs)} {args.split} designs of no project a model trained on", flush=True)
     ranks = guide_ranks(
         args.labels, args.graphs, make_guides(args.guides, args.model, args.seed), args.split, designs
     )

@@ -49,9 +49,13 @@ def guide_settings(checkpoint: dict[str, Any]) -> tuple[int | None, dict[str, An
 
 
 def fold_checkpoint(checkpoint: dict[str, Any]) -> FoldedScorer:
-    """A late-fusion checkpoint's scorer as numpy arrays, with its :func:`guide_settings`."""
+    """A late-fusion checkpoint's scorer as numpy arrays, with its :func:`guide_settings` and the
+    projects it trained on."""
     samples, search = guide_settings(checkpoint)
-    return replace(fold(scorer_from(checkpoint)), points_per_zone=samples, search=search)
+    projects = tuple(checkpoint.get("provenance", {}).get("train_projects", ()))
+    return replace(
+        fold(scorer_from(checkpoint)), points_per_zone=samples, search=search, train_projects=projects
+    )
 
 
 def fold(model: ProposalScorer) -> FoldedScorer:

@@ -80,6 +80,7 @@ class FoldedScorer:
     features: Chain = ()
     points_per_zone: int | None = None  # the surface samples per zone it was trained with
     search: dict[str, Any] = field(default_factory=dict)  # the guide's defaults (top_m, blend)
+    train_projects: tuple[str, ...] = ()  # the projects it saw in training: evaluation skips them
 
     def encode_geometry(self, points: np.ndarray) -> np.ndarray | None:
         """(Z, H) each zone's geometry as it enters ``zone_in``'s first layer (its PointNet code
@@ -172,6 +173,7 @@ class FoldedScorer:
             "layout": layout,
             "points_per_zone": self.points_per_zone,
             "search": self.search,
+            "train_projects": list(self.train_projects),
         }
         arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
         np.savez(path, **arrays)  # type: ignore[arg-type]
@@ -202,6 +204,7 @@ class FoldedScorer:
             features=chains["features"][0] if chains["features"] else (),
             points_per_zone=meta["points_per_zone"],
             search=meta["search"],
+            train_projects=tuple(meta.get("train_projects", ())),
         )
 
     def _chains(self) -> dict[str, tuple[Chain, ...]]:

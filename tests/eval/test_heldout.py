@@ -1,0 +1,25 @@
+"""Held-out designs: the projects a model trained on, from either file, and halves by project."""
+
+from __future__ import annotations
+
+import pytest
+
+from eval.heldout import part_of, trained_projects
+from zonegraph.network.checkpoint import SHIPPED
+from zonegraph.network.folded import SHIPPED_FOLDED
+
+
+def test_the_shipped_fold_names_the_projects_its_checkpoint_trained_on():
+    from_pt, silent_pt = trained_projects([SHIPPED])
+    from_npz, silent_npz = trained_projects([SHIPPED_FOLDED])
+    assert len(from_pt) > 1000 and from_npz == from_pt and silent_pt == silent_npz == []
+
+
+def test_two_parts_split_designs_by_project_and_keep_their_order():
+    ids = [f"{p}_{h}_{i:04d}" for p in range(100, 140) for h in ("aa", "bb") for i in range(2)]
+    tune, report = part_of(ids, "tune", 3), part_of(ids, "report", 3)
+    assert sorted(tune + report) == sorted(ids) and tune == sorted(tune) and report == sorted(report)
+    assert not {d.rsplit("_", 1)[0] for d in tune} & {d.rsplit("_", 1)[0] for d in report}  # projects
+    assert part_of(ids, "tune", 3) == tune != part_of(ids, "tune", 4) and part_of(ids, None, 3) == ids
+    with pytest.raises(ValueError, match="unknown part"):
+        part_of(ids, "test", 0)
