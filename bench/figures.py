@@ -11,6 +11,7 @@
     python -m bench.figures build|search|replay NAME DIR/results.json --command "python -m bench..."
     python -m bench.figures guide-cost NAME DIR/guide_cost.json --command "python -m bench.guide_cost..."
     python -m bench.figures report NAME REPORT_DIR --command "python -m eval.report ..."
+    python -m bench.figures rank NAME DIR/rank.json --command "python -m eval.rank ..."
 
 A results page never carries a number typed by hand: a benchmark's ``results.json`` (its per-design
 rows, or its summary) is reduced here to a small figure file, ``docs/figures/NAME.json``, holding
@@ -317,6 +318,34 @@ def report_figure(folder: Path) -> dict:
     return figure
 
 
+RANK_METRICS = ("rank", "floor", "normalised", "top1", "top5")
+
+
+def rank_figure(results: dict) -> dict:
+    """The GT rank per guide (``eval.rank``'s ``rank.json``): designs, ranked and single steps,
+    every scale with its 90% interval, and each guide's normalised rank over the heuristic's."""
+    guides = {}
+    for r in results["guides"]:
+        entry = {"designs": int(r["designs"]), "steps": int(r["steps"]), "single": int(r["single"])}
+        for metric in RANK_METRICS:
+            prefix = "" if metric == "rank" else f"{metric}_"
+            entry[metric] = _rounded(r.get(metric), 4)
+            if metric != "floor":
+                entry[f"{metric}_ci"] = [
+                    _rounded(r.get(f"{prefix}ci_low"), 4),
+                    _rounded(r.get(f"{prefix}ci_high"), 4),
+                ]
+        guides[str(r["guide"])] = entry
+    ratios = {
+        str(r["guide"]): {
+            "ratio": _rounded(r["ratio"], 3),
+            "ci": [_rounded(r["ci_low"], 3), _rounded(r["ci_high"], 3)],
+        }
+        for r in results.get("vs_heuristic", [])
+    }
+    return {"guides": guides, "vs_heuristic": ratios}
+
+
 FIGURES_OF = {
     "build": build_figure,
     "search": search_figure,
@@ -328,6 +357,7 @@ FIGURES_OF = {
     "fuzz": fuzz_figure,
     "verify": verify_figure,
     "guide-cost": guide_cost_figure,
+    "rank": rank_figure,
 }
 
 

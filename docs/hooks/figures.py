@@ -329,6 +329,39 @@ def report(records: list[dict]) -> str:
     return "\n".join(lines) + "\nMeasured by:\n\n" + _sources(records)
 
 
+def rank(records: list[dict]) -> str:
+    """The GT's rank per guide on every scale (means over steps, 90% intervals over designs), then
+    each guide's normalised rank over the heuristic's (paired interval)."""
+    lines = [
+        "| run | guide | designs | steps (single left out) | rank / P | floor | normalised rank | "
+        "top-1 | top-5 |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+
+    def cell(g: dict, metric: str, digits: int) -> str:
+        low, high = g[f"{metric}_ci"]
+        return f"{g[metric]:.{digits}f} ({low:.{digits}f} - {high:.{digits}f})"
+
+    ratios = []
+    for r in records:
+        for name, g in r["figure"]["guides"].items():
+            scales = [cell(g, "rank", 4), f"{g['floor']:.4f}", cell(g, "normalised", 4)]
+            scales += [cell(g, "top1", 3), cell(g, "top5", 3)]
+            head = f"| {r['name']} | {name} | {g['designs']} | {g['steps']} ({g['single']}) | "
+            lines.append(head + " | ".join(scales) + " |")
+        for name, v in r["figure"]["vs_heuristic"].items():
+            ratios.append(
+                f"| {r['name']} | {name} | {v['ratio']:.3f} | {v['ci'][0]:.3f} - {v['ci'][1]:.3f} |"
+            )
+    text = "\n".join(lines)
+    if ratios:
+        text += (
+            "\n\n| run | guide | normalised rank / heuristic's | 90% CI (paired) |\n|---|---|---|---|\n"
+            + "\n".join(ratios)
+        )
+    return text + "\n\nMeasured by:\n\n" + _sources(records)
+
+
 RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "build": build,
     "search": search,
@@ -342,6 +375,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "fuzz": fuzz,
     "guide-cost": guide_cost,
     "report": report,
+    "rank": rank,
 }
 
 

@@ -16,6 +16,7 @@ from bench.figures import (
     fault_figure,
     fuzz_figure,
     guide_cost_figure,
+    rank_figure,
     report_figure,
 )
 
@@ -250,3 +251,44 @@ def test_the_report_figure_reads_each_curve_at_the_last_point_before_each_time(t
     record = {"name": "r", "command": "python -m eval.report", "commit": "abc1234", "measured": "2026-12-05"}
     table = _hook().report([record | {"figure": figure}])
     assert "| heuristic | 2 | 0.900 / 50.0% | 1.000 / 100.0% | 1.000 / 100.0% | 1.000 / 100.0% |" in table
+
+
+def test_the_rank_figure_keeps_every_scale_with_its_interval_and_the_ratio():
+    results = {
+        "guides": [
+            {
+                "guide": "heuristic",
+                "designs": 10,
+                "steps": 30,
+                "single": 4,
+                "rank": 0.24,
+                "ci_low": 0.22,
+                "ci_high": 0.26,
+                "floor": 0.17,
+                "normalised": 0.072,
+                "normalised_ci_low": 0.06,
+                "normalised_ci_high": 0.084,
+                "top1": 0.6,
+                "top1_ci_low": 0.5,
+                "top1_ci_high": 0.7,
+                "top5": 0.8,
+                "top5_ci_low": 0.75,
+                "top5_ci_high": 0.85,
+            },
+        ],
+        "vs_heuristic": [
+            {"guide": "net", "base": "heuristic", "ratio": 0.5491, "ci_low": 0.473, "ci_high": 0.625}
+        ],
+    }
+    figure = rank_figure(results)
+    heuristic = figure["guides"]["heuristic"]
+    assert heuristic["normalised"] == 0.072 and heuristic["normalised_ci"] == [0.06, 0.084]
+    assert heuristic["rank_ci"] == [0.22, 0.26] and "floor_ci" not in heuristic
+    assert figure["vs_heuristic"]["net"] == {"ratio": 0.549, "ci": [0.473, 0.625]}
+    record = {"name": "run", "command": "python -m eval.rank", "commit": "abc1234", "measured": "2026-12-06"}
+    table = _hook().rank([record | {"figure": figure}])
+    assert (
+        "| run | heuristic | 10 | 30 (4) | 0.2400 (0.2200 - 0.2600) | 0.1700 | 0.0720 (0.0600 - 0.0840) |"
+        in table
+    )
+    assert "| run | net | 0.549 | 0.473 - 0.625 |" in table
