@@ -3,7 +3,7 @@ and combined, ranked on held-out designs.
 
     python -m pipelines.ablations [--params params.yaml] [--variants base listwise features ...]
                                   [--rounds 0 1 2 3 4] [--designs 300] [--epochs 3]
-                                  [--eval-designs 100] [--compare CHECKPOINT ...]
+                                  [--eval-designs 100] [--part tune|report] [--compare CHECKPOINT ...]
                                   [--labels DIR] [--graphs DIR] [--eval-labels DIR --eval-graphs DIR]
                                   [--out data/eval/ablations]
 
@@ -35,7 +35,7 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from eval.heldout import held_out_labelled, trained_projects
+from eval.heldout import PARTS, held_out_labelled, part_of, trained_projects
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, ratios, summarise
 from training.train import TrainConfig, train
 from zonegraph.sequence.features import FEATURES
@@ -170,6 +170,8 @@ def main() -> None:
     parser.add_argument("--designs", type=int, default=300, help="training designs per variant (0: all)")
     parser.add_argument("--epochs", type=int, default=3)
     parser.add_argument("--eval-designs", type=int, default=100)
+    parser.add_argument("--part", choices=PARTS, default=None, help="rank on one half of them by project")
+    parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
     parser.add_argument(
         "--compare", nargs="*", default=[], help="other checkpoints ranked beside them: PATH[@knob=value,...]"
     )
@@ -196,7 +198,7 @@ def main() -> None:
     compared = list(args.compare)  # checkpoints, each may carry the guide's knobs (PATH@top_m=8)
     seen, _ = trained_projects([*models, *(c.partition("@")[0] for c in compared)])
     labels, graphs = args.eval_labels or base.labels_dir, args.eval_graphs or base.graphs_dir
-    designs = held_out_labelled(labels, "test", seen)[: args.eval_designs]
+    designs = part_of(held_out_labelled(labels, "test", seen), args.part, args.part_seed)[: args.eval_designs]
     guides = make_guides(["random", "heuristic"], [*models, *compared], base.seed)
     ranks = guide_ranks(labels, graphs, guides, "test", designs)
     ranks.to_parquet(args.out / "ranks.parquet", index=False)
