@@ -152,6 +152,21 @@ class _Candidates:
         return np.concatenate([keys, ops[:, None]], axis=1), interleaved
 
 
+@dataclass(frozen=True)
+class _Slab:
+    """A plane pair's sweep direction and length, the planes' zone sides as lists, and which faces
+    a sweep crosses out of their first and their second zone."""
+
+    d: np.ndarray
+    length: float
+    side_s: int
+    side_e: int
+    on_s: list[int]
+    on_e: list[int]
+    from_a: list[bool]
+    from_b: list[bool]
+
+
 class ProposalGenerator:
     """Proposals for any canvas of one zone graph, with every canvas-independent part precomputed."""
 
@@ -173,6 +188,7 @@ class ProposalGenerator:
         self._crossed: dict[tuple[int, int], tuple[list[bool], list[bool]]] = {}
         self._groups: dict[tuple[int, int, bytes], _Candidates] = {}
         self._reach: dict[tuple[int, int], _Reach] = {}
+        self._slabs: dict[tuple[int, int], _Slab] = {}
         self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
         self._flatten_pairs()
 
@@ -249,28 +265,42 @@ class ProposalGenerator:
             self._sweeps[key] = self._sweep(face, s, e)
         return self._sweeps[key]
 
+    def _slab(self, s: int, e: int) -> _Slab:
+        """What every sweep from s to e shares (memoised per pair): a root expansion sweeps
+        hundreds of faces per pair, and computing these per sweep was half of a small sweep's
+        cost."""
+        key = (s, e)
+        slab = self._slabs.get(key)
+        if slab is None:
+            g = self.graph
+            d = self.direction(s, e)
+            side_s = 1 if float(g.surface_normal[s] @ d) > 0 else -1
+            side_e = 1 if float(g.surface_normal[e] @ d) > 0 else -1
+            from_a, from_b = self._crossings(s, e)
+            slab = self._slabs[key] = _Slab(
+                d, float(np.linalg.norm(d)), side_s, side_e, self._sides(s), self._sides(e), from_a, from_b
+            )
+        return slab
+
     def _sweep(self, face: int, s: int, e: int) -> Sweep | None:
         g = self.graph
-        d = self.direction(s, e)
-        length = float(np.linalg.norm(d))
-        side_s = 1 if float(g.surface_normal[s] @ d) > 0 else -1
-        side_e = 1 if float(g.surface_normal[e] @ d) > 0 else -1
-        a, b = g.face_zones[face]
-        start = b if float(g.face_normal[face] @ d) > 0 else a
+        slab = self._slab(s, e)
+        a, b = self._face_zone_list[face]
+        start = b if float(g.face_normal[face] @ slab.d) > 0 else a
         if start < 0:
             return None
-        on_s, on_e = self._sides(s), self._sides(e)
-        crossed_from_a, crossed_from_b = self._crossings(s, e)
+        on_s, on_e, side_s, side_e = slab.on_s, slab.on_e, slab.side_s, -slab.side_e
+        crossed_from_a, crossed_from_b = slab.from_a, slab.from_b
         face_zones, face_surface = self._face_zone_list, self._face_surface_list
-        seen = bytearray(g.n_zones)
+        seen: set[int] = set()
         stack = [int(start)]
         while stack:
             z = stack.pop()
-            if seen[z]:
+            if z in seen:
                 continue
-            if on_s[z] != side_s or on_e[z] != -side_e:
+            if on_s[z] != side_s or on_e[z] != side_e:
                 return None  # the zone reaches outside the slab between s and e
-            seen[z] = 1
+            seen.add(z)
             for f in self._zone_face_lists[z]:
                 if face_surface[f] == e:
                     continue
@@ -282,13 +312,16 @@ class ProposalGenerator:
                 if other < 0:
                     return None
                 stack.append(other)
-        zones = np.frombuffer(bytes(seen), np.uint8).astype(bool)
-        volume = float(g.zone_volume[zones].sum())
-        if abs(volume - g.face_area[face] * length) <= PRISM_RTOL * g.face_area[face] * length:
+        members = np.sort(np.fromiter(seen, np.int64, len(seen)))  # summed in the zones' order
+        volume = float(g.zone_volume[members].sum())
+        zones = np.zeros(g.n_zones, bool)
+        zones[members] = True
+        prism = g.face_area[face] * slab.length
+        if abs(volume - prism) <= PRISM_RTOL * prism:
             return Sweep(zones, (face,))
         under = self._faces_under(zones, s, e)
         area = float(g.face_area[under].sum())
-        if face not in under or abs(volume - area * length) > PRISM_RTOL * area * length:
+        if face not in under or abs(volume - area * slab.length) > PRISM_RTOL * area * slab.length:
             return None
         return Sweep(zones, tuple(under))
 
