@@ -2,7 +2,8 @@
 
     python -m bench.guide_cost_bench --graphs data/zonegraphs/graphs --gt data/gt
         [--guides heuristic net=CHECKPOINT net=CHECKPOINT@top_m=8,blend=0.5,margin=0.1 ...]
-        [--designs 20] [--budgets 1 5] [--seed 7] [--out bench_out/guide_cost]
+        [--designs 20] [--budgets 1 5] [--seed 7] [--repeat 1] [--part tune|report]
+        [--out bench_out/guide_cost]
 
 Searches the saved (simplified) zone graph of a seeded sample of test designs, stratified by
 timeline folder and none of a project any checkpoint trained on, once per guide and budget, in
@@ -71,6 +72,22 @@ def one_search(graph: Any, guide: GuideSpec, budget: float, seed: int) -> dict[s
     }
 
 
+def fastest(graph: Any, guide: GuideSpec, budget: float, seed: int, repeat: int) -> dict[str, Any]:
+    """The first search's outcome with the least time of ``repeat`` runs of it: on a loaded
+    machine one run's seconds stretch by a fifth either way, and the least of a few is what the
+    search itself costs (as ``timeit`` takes). A run whose outcome differs (a budget that bit at
+    another expansion) counts no time."""
+    first = one_search(graph, guide, budget, seed)
+    for _ in range(repeat - 1):
+        again = one_search(graph, guide, budget, seed)
+        if (again["exact"], again["expansions"]) != (first["exact"], first["expansions"]):
+            continue
+        for key in ("time_to_exact_s", "search_wall_s", "search_cpu_s"):
+            if again[key] is not None and first[key] is not None:
+                first[key] = min(first[key], again[key])
+    return first
+
+
 def summary(rows: pd.DataFrame) -> pd.DataFrame:
     """Per guide and budget: exact counts over designs (all, GT >= 3) and median time to exact on
     the designs every guide solved at that budget."""
@@ -125,6 +142,7 @@ def main() -> None:
     parser.add_argument("--designs", type=int, default=20)
     parser.add_argument("--budgets", type=float, nargs="+", default=[1.0, 5.0])
     parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--repeat", type=int, default=1, help="runs of each search; the least time counts")
     parser.add_argument("--part", choices=PARTS, default=None, help="one half of the designs by project")
     parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
     parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))
@@ -140,7 +158,7 @@ def main() -> None:
         graph = load_zone_graph(args.graphs / design.design_id, solids=False)
         for budget in args.budgets:
             for guide in guides:
-                found = one_search(graph, guide, budget, args.seed)
+                found = fastest(graph, guide, budget, args.seed, args.repeat)
                 rows.append(
                     {"design_id": design.design_id, "gt_steps": int(design.steps), "zones": graph.n_zones}
                     | {"guide": guide.label, "budget": budget, **found}
