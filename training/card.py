@@ -92,7 +92,8 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
         knobs = ", ".join(f"{k} {v}" for k, v in checkpoint["search"].items())
         lines.append(
             f"- search defaults stored with the weights: {knobs} (top_m: only the heuristic's top M "
-            "proposals of a state are scored, the rest keep the heuristic's order below them)"
+            "proposals of a state are scored, the rest keep the heuristic's order below them; margin: "
+            "only those within that much of the heuristic's best score, none when one leads alone)"
         )
     lines += [
         "",
@@ -119,9 +120,16 @@ def main() -> None:
     parser.add_argument(
         "--blend", type=float, default=None, help="store: the heuristic's weight in the score"
     )
+    parser.add_argument(
+        "--margin",
+        type=float,
+        default=None,
+        help="store: score only those within this of the heuristic's best",
+    )
     args = parser.parse_args()
     checkpoint = torch.load(args.checkpoint, map_location="cpu", weights_only=True)
-    search = {k: v for k, v in (("top_m", args.top_m), ("blend", args.blend)) if v is not None}
+    knobs = (("top_m", args.top_m), ("blend", args.blend), ("margin", args.margin))
+    search = {k: v for k, v in knobs if v is not None}
     if search:  # the guide's defaults (NetworkRanker reads them), kept with the weights they suit
         checkpoint["search"] = {**checkpoint.get("search", {}), **search}
         torch.save(checkpoint, args.checkpoint)
