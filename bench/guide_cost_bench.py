@@ -148,7 +148,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))
     args = parser.parse_args()
     guides = [GuideSpec.parse(g) for g in args.guides]
-    models = [g.model for g in guides if g.model]  # a .npz carries no provenance: name the .pt
+    models = [g.model for g in guides if g.model]
     designs = chosen_designs(args.gt, args.graphs, models, args.designs, args.seed, args.part, args.part_seed)
     print(
         f"guide_cost_bench: {len(designs)} designs: {designs['folder'].value_counts().sort_index().to_dict()}"

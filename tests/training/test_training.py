@@ -55,6 +55,20 @@ def test_a_nan_score_ranks_last():
     assert relative_rank(np.array([0.5, np.nan, np.nan]), np.array([True, False, False])) == 1 / 3
 
 
+def _quick(labelled, **overrides) -> TrainConfig:
+    """A one-epoch CPU run on the labelled samples' shards, with ``overrides``."""
+    settings = dict(
+        labels_dir=str(labelled / "labels"),
+        graphs_dir=str(labelled / "graphs"),
+        epochs=1,
+        val_fraction=0.34,
+        points_per_zone=16,
+        batch_states=4,
+        device="cpu",
+    )
+    return TrainConfig(**{**settings, **overrides})
+
+
 @pytest.fixture(scope="module")
 def labelled(samples_dir, tmp_path_factory):
     """Zone graphs (32 samples per zone) and labels of three real samples, as the stages write them."""
@@ -236,16 +250,7 @@ def test_the_shipped_checkpoint_guides_without_a_model_path_and_has_its_card(sam
 @requires_samples
 def test_an_ablation_variant_trains_once_then_is_reused(labelled, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    base = TrainConfig(
-        labels_dir=str(labelled / "labels"),
-        graphs_dir=str(labelled / "graphs"),
-        epochs=1,
-        val_fraction=0.34,
-        points_per_zone=16,
-        batch_states=4,
-        device="cpu",
-        experiment="ablations",
-    )
+    base = _quick(labelled, experiment="ablations")
     configs = variants(base, [0])
     assert list(configs) == ["rounds0", "rounds3_no_points"] and not configs["rounds3_no_points"].use_points
     path = train_variant("rounds0", configs["rounds0"], tmp_path / "out")
@@ -319,23 +324,15 @@ def test_a_narrow_student_learns_from_a_teacher_folds_and_owns_its_projects(labe
     from zonegraph.sequence.features import FEATURES
 
     monkeypatch.chdir(tmp_path)
-    common = dict(
-        labels_dir=str(labelled / "labels"),
-        graphs_dir=str(labelled / "graphs"),
-        epochs=1,
-        val_fraction=0.34,
-        points_per_zone=16,
-        batch_states=4,
-        loss="listwise",
-        features=FEATURES,
-        use_points=False,
-    )
-    train(TrainConfig(**common, out_dir="teacher"))
+    common = dict(loss="listwise", features=FEATURES, use_points=False)
+    train(_quick(labelled, **common, out_dir="teacher"))
     teacher = read_checkpoint(tmp_path / "teacher" / "scorer.pt")
     teacher["provenance"]["train_projects"].append("elsewhere")  # a project only the teacher saw
     torch.save(teacher, tmp_path / "teacher" / "scorer.pt")
     train(
-        TrainConfig(**common, out_dir="student", hidden=16, teacher=str(tmp_path / "teacher" / "scorer.pt"))
+        _quick(
+            labelled, **common, out_dir="student", hidden=16, teacher=str(tmp_path / "teacher" / "scorer.pt")
+        )
     )
     student = read_checkpoint(tmp_path / "student" / "scorer.pt")
     assert student["model"]["hidden"] == 16 and student["train"]["teacher"].endswith("teacher/scorer.pt")
@@ -343,7 +340,9 @@ def test_a_narrow_student_learns_from_a_teacher_folds_and_owns_its_projects(labe
     folded = fold_checkpoint(student)
     assert folded.rounds[0][0].weight.shape == (32, 16)
     with pytest.raises(SystemExit, match="loss listwise"):
-        TrainConfig(**{**common, "loss": "focal"}, teacher=str(tmp_path / "teacher" / "scorer.pt")).check()
+        _quick(
+            labelled, **{**common, "loss": "focal"}, teacher=str(tmp_path / "teacher" / "scorer.pt")
+        ).check()
 
 
 @requires_samples

@@ -185,7 +185,6 @@ class ProposalGenerator:
         self._face_surface_list = graph.face_surface.tolist()
         self._zone_face_lists = [faces.tolist() for faces in self._zone_faces]
         self._side_lists: dict[int, list[int]] = {}
-        self._crossed: dict[tuple[int, int], tuple[list[bool], list[bool]]] = {}
         self._groups: dict[tuple[int, int, bytes], _Candidates] = {}
         self._reach: dict[tuple[int, int], _Reach] = {}
         self._slabs: dict[tuple[int, int], _Slab] = {}
@@ -276,9 +275,10 @@ class ProposalGenerator:
             d = self.direction(s, e)
             side_s = 1 if float(g.surface_normal[s] @ d) > 0 else -1
             side_e = 1 if float(g.surface_normal[e] @ d) > 0 else -1
-            from_a, from_b = self._crossings(s, e)
+            length = float(np.linalg.norm(d))
+            from_a, from_b = self._crossings(d, length)
             slab = self._slabs[key] = _Slab(
-                d, float(np.linalg.norm(d)), side_s, side_e, self._sides(s), self._sides(e), from_a, from_b
+                d, length, side_s, side_e, self._sides(s), self._sides(e), from_a, from_b
             )
         return slab
 
@@ -364,28 +364,23 @@ class ProposalGenerator:
             self._side_lists[plane] = self.graph.plane_side[plane].tolist()
         return self._side_lists[plane]
 
-    def _crossings(self, s: int, e: int) -> tuple[list[bool], list[bool]]:
-        """For every face, whether a sweep along d (from s to e) goes on through it out of its
-        first zone, and out of its second (memoised per plane pair): a planar face when it faces
-        along d (a cap); a curved face unless it lies on a cylinder or extrusion along d (a side
-        wall); never a face inside one zone (the sweep is on both of its sides already).
-        Classifying all faces at once replaced a per-face test that was half a sweep's cost on
-        graphs of thousands of zones."""
-        key = (s, e)
-        if key not in self._crossed:
-            g = self.graph
-            d = self.direction(s, e)
-            length = float(np.linalg.norm(d))
-            planar = np.isfinite(g.face_normal[:, 0])
-            along = np.where(planar[:, None], g.face_normal, 0.0) @ d  # face normals point a -> b
-            surface = g.face_surface
-            wall = (surface >= 0) & np.isin(g.surface_kind[np.maximum(surface, 0)], SIDE_WALL_KINDS)
-            axis = g.surface_axis[np.maximum(surface, 0), 3:] @ d
-            curved = ~wall | (1 - np.abs(axis) / length >= PARALLEL_TOL)
-            from_a = np.where(planar, along > PARALLEL_TOL * length, curved) & ~self.internal
-            from_b = np.where(planar, -along > PARALLEL_TOL * length, curved) & ~self.internal
-            self._crossed[key] = (from_a.tolist(), from_b.tolist())
-        return self._crossed[key]
+    def _crossings(self, d: np.ndarray, length: float) -> tuple[list[bool], list[bool]]:
+        """For every face, whether a sweep along d (of ``length``) goes on through it out of its
+        first zone, and out of its second (kept per plane pair by :meth:`_slab`): a planar face
+        when it faces along d (a cap); a curved face unless it lies on a cylinder or extrusion
+        along d (a side wall); never a face inside one zone (the sweep is on both of its sides
+        already). Classifying all faces at once replaced a per-face test that was half a sweep's
+        cost on graphs of thousands of zones."""
+        g = self.graph
+        planar = np.isfinite(g.face_normal[:, 0])
+        along = np.where(planar[:, None], g.face_normal, 0.0) @ d  # face normals point a -> b
+        surface = g.face_surface
+        wall = (surface >= 0) & np.isin(g.surface_kind[np.maximum(surface, 0)], SIDE_WALL_KINDS)
+        axis = g.surface_axis[np.maximum(surface, 0), 3:] @ d
+        curved = ~wall | (1 - np.abs(axis) / length >= PARALLEL_TOL)
+        from_a = np.where(planar, along > PARALLEL_TOL * length, curved) & ~self.internal
+        from_b = np.where(planar, -along > PARALLEL_TOL * length, curved) & ~self.internal
+        return from_a.tolist(), from_b.tolist()
 
     # ------------------------------------------------------------------------ proposals
 
