@@ -115,3 +115,26 @@ def test_zone_iou_is_never_above_one():
         graph = SimpleNamespace(zone_volume=np.where(target, volumes, 1e-17 * volumes))
         assert zone_iou(graph, everything, target) <= 1.0
         assert zone_iou(graph, target, target) == 1.0
+
+
+class CountingRanker:
+    """The heuristic reversed (its worst proposal first), counting the states it is asked about."""
+
+    def __init__(self) -> None:
+        self.calls = 0
+
+    def score(self, graph, canvas, proposals):
+        self.calls += 1
+        return -HeuristicRanker().score(graph, canvas, proposals)
+
+
+def test_a_step_that_completes_the_target_is_taken_without_scoring():
+    ring = graph_of(Box(4, 4, 1) - Cylinder(1, 1))  # one extrusion of the ring completes it
+    ranker = CountingRanker()
+    result = search(ring, ranker, SearchConfig(budget_s=10))
+    assert result.exact and len(result.steps) == 1 and result.expansions == 1
+    assert ranker.calls == 0  # the reversed ranker would have put the ring last
+    step = graph_of(Box(4, 4, 1) + Pos(0, 0, 1) * Box(2, 2, 1))  # two unions: the first is scored
+    ranker = CountingRanker()
+    result = search(step, ranker, SearchConfig(budget_s=10, k=50))
+    assert result.exact and ranker.calls == result.expansions - 1
