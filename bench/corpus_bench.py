@@ -3,7 +3,8 @@
     python -m bench.corpus_bench [--per-folder 25] [--budget 20] [--seed 0] [--workers 2]
                                  [--guide heuristic|random|net] [--model PATH]
                                  [--index data/designs/index.parquet --split test]
-                                 [--fresh-from 0 ...] [--against OLD/results.json]
+                                 [--fresh-from 0 ...] [--fresh-per-folder 25] [--folders 05 06]
+                                 [--against OLD/results.json]
                                  [--corpus ../shared/data/fusion360_b123d] [--out bench_out/corpus]
 
 A seeded sample with the same number of designs from every timeline folder of the build123d corpus
@@ -50,20 +51,27 @@ def sample(
     seed: int,
     keep: set[str] | None = None,
     fresh_from: Sequence[int] = (),
+    fresh_per_folder: int | None = None,
+    folders: Sequence[str] = (),
 ) -> list[CorpusEntry]:
-    """``per_folder`` designs from every timeline folder, seeded (all of a smaller folder), drawn
-    from the designs in ``keep`` when given, and never one that the samples of the seeds
-    ``fresh_from`` drew. Those samples form a chain: each seed is drawn fresh from the seeds before
-    it, so ``(0, 2023)`` leaves out the tuning sample and the validation sample drawn beside it."""
+    """``per_folder`` designs from every timeline folder (or those whose names start with one of
+    ``folders``), seeded (all of a smaller folder), drawn from the designs in ``keep`` when given,
+    and never one that the samples of the seeds ``fresh_from`` drew. Those samples form a chain:
+    each seed is drawn fresh from the seeds before it, so ``(0, 2023)`` leaves out the tuning sample
+    and the validation sample drawn beside it. They drew ``fresh_per_folder`` designs per folder
+    (by default ``per_folder``): a larger diagnosis sample still leaves out exactly those two."""
     taken: set[str] = set()
+    earlier_size = per_folder if fresh_per_folder is None else fresh_per_folder
     for i, earlier in enumerate(fresh_from):
-        taken |= {e.design_id for e in sample(corpus, per_folder, earlier, keep, fresh_from[:i])}
+        taken |= {e.design_id for e in sample(corpus, earlier_size, earlier, keep, fresh_from[:i])}
     rng = np.random.default_rng(seed)
     entries = [
         e for e in list_corpus(corpus) if (keep is None or e.design_id in keep) and e.design_id not in taken
     ]
     out = []
     for folder in sorted({e.folder for e in entries}):
+        if folders and not folder.startswith(tuple(folders)):
+            continue
         members = [e for e in entries if e.folder == folder]
         picks = rng.choice(len(members), size=min(per_folder, len(members)), replace=False)
         out += [members[i] for i in sorted(picks)]
@@ -189,10 +197,16 @@ def main() -> None:
         default=(),
         help="leave out the designs the samples of these seeds draw (each fresh from those before it)",
     )
+    parser.add_argument(
+        "--fresh-per-folder", type=int, default=None, help="designs per folder of the --fresh-from samples"
+    )
+    parser.add_argument("--folders", nargs="*", default=(), help="only these timeline folders (e.g. 05 06)")
     args = parser.parse_args()
     require_corpus(args.corpus)
     keep = split_ids(args.index, args.split) if args.index else None
-    entries = sample(args.corpus, args.per_folder, args.seed, keep, args.fresh_from)
+    entries = sample(
+        args.corpus, args.per_folder, args.seed, keep, args.fresh_from, args.fresh_per_folder, args.folders
+    )
     config = InferConfig(guide=args.guide, budget_s=args.budget, model=args.model)
     fresh = f", none drawn by seeds {' '.join(map(str, args.fresh_from))}" if args.fresh_from else ""
     print(
