@@ -31,3 +31,12 @@ def test_the_regression_list_names_tuning_designs_only() -> None:
     assert {e.expected for e in listed} <= {"exact", "partial"}
     assert all(tuning().get(e.design_id) == e.folder for e in listed)
     assert len({e.folder for e in listed if e.expected == "exact"}) == 8
+
+
+@requires_corpus
+def test_a_larger_diagnosis_sample_of_chosen_folders_leaves_out_both_samples() -> None:
+    validation = {e.design_id for e in sample(CORPUS, 25, VALIDATION_SEED, fresh_from=(TUNING_SEED,))}
+    drawn = sample(CORPUS, 70, 7373, None, (TUNING_SEED, VALIDATION_SEED), 25, ("05", "06"))
+    ids = {e.design_id for e in drawn}
+    assert {e.folder for e in drawn} == {"05_8to10ops", "06_11to15ops"} and len(ids) == 140
+    assert not ids & (validation | tuning().keys())
