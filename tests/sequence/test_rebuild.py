@@ -50,6 +50,9 @@ WORK = InferConfig(budget_s=math.inf, max_expansions=2000)  # the same search on
         # a notched block and a cylinder filling the notch: merging the union's faces in place
         # broke the raw union it shared sub-shapes with, and the rebuild measured IoU 0
         ("04_6to7ops/batch_001.py", "124497_5c00f42d_0012"),
+        # a sketch of two nested annuli: merging the faces of their fused prisms gave an invalid
+        # tool of 1.6 times their volume, and the rebuild 0.85 of the target's
+        ("05_8to10ops/batch_003.py", "21803_8a36dcda_0017"),
     ],
 )
 def test_a_zone_exact_program_rebuilds_exactly(batch, design_id, tmp_path):

@@ -94,8 +94,22 @@ def fuzzy_boolean(
     Raises:
         ValueError: the Boolean reported errors.
     """
+    return boolean_of(operation, a, [b], fuzzy)
+
+
+def boolean_of(
+    operation: BRepAlgoAPI_BooleanOperation,
+    a: TopoDS_Shape,
+    tools: Sequence[TopoDS_Shape],
+    fuzzy: float = 0.0,
+) -> TopoDS_Shape:
+    """``a`` (op) every one of ``tools`` in one Boolean, on copies, as :func:`fuzzy_boolean`.
+
+    Raises:
+        ValueError: the Boolean reported errors.
+    """
     operation.SetArguments(shape_list([BRepBuilderAPI_Copy(a).Shape()]))
-    operation.SetTools(shape_list([BRepBuilderAPI_Copy(b).Shape()]))
+    operation.SetTools(shape_list([BRepBuilderAPI_Copy(t).Shape() for t in tools]))
     operation.SetFuzzyValue(fuzzy)
     operation.SetRunParallel(False)
     operation.Build()
