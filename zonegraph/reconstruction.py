@@ -32,7 +32,7 @@ from zonegraph.export.writers import write_outputs
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.deadline import Deadline
 from zonegraph.sequence.diagnosis import Diagnosis, diagnose
-from zonegraph.sequence.program import ProgramStep, RebuildError, brep_iou, build_program, execute
+from zonegraph.sequence.program import ProgramStep, RebuildError, build_program, execute, measured
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import make_ranker
 from zonegraph.status import Status, plural
@@ -340,7 +340,8 @@ def infer(
     try:
         program = build_program(rec.graph, rec.result.steps, rec.generator)
         states = execute(program)
-        iou = brep_iou(states[-1] if states else None, target)
+        if states and states[-1] is not None:
+            states[-1], iou = measured(program, states[-1], target, rec.result.iou)
     except RebuildError as exc:
         rebuild_error = str(exc)
     if not rebuild_error and rec.result.exact and iou < EXACT_IOU:

@@ -11,7 +11,7 @@ from zonegraph.data.replay import as_shape
 from zonegraph.geometry.shapes import write_brep
 from zonegraph.reconstruction import infer
 from zonegraph.sequence.best_first import SearchConfig, search
-from zonegraph.sequence.program import brep_iou, build_program, execute
+from zonegraph.sequence.program import brep_iou, build_program, execute, measured
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import HeuristicRanker
 from zonegraph.testing import requires_corpus
@@ -102,3 +102,20 @@ def test_exactness_is_the_rebuilt_parts_not_the_zones(tmp_path):
     result = infer(target, tmp_path / "out", WORK, render=False)
     assert result.iou_zone < 1.0 and result.iou_brep >= 0.9999
     assert result.exact and result.status == "exact"
+
+
+def test_a_program_whose_commons_with_the_target_fail_is_measured_on_its_cells():
+    """A 15-step program rebuilds to the target's volume (to 8e-7), yet every common of that
+    rebuild with the target comes back empty: B-rep IoU 0 against zone IoU 0.99999998. The same
+    program evaluated on the cells of its tools measures what its zones say."""
+    solids = list(corpus_shape("06_11to15ops/batch_002.py", "21732_adaf1650_0010").solids())
+    graph = build_zone_graph(solids, simplify=True, samples=0)
+    generator = ProposalGenerator(graph)
+    result = search(graph, HeuristicRanker(), SearchConfig(budget_s=math.inf, max_expansions=60), generator)
+    assert result.iou > 0.9999
+    program = build_program(graph, result.steps, generator)
+    target = as_shape(solids)
+    part = execute(program)[-1]
+    assert brep_iou(part, target) < 0.5  # the sequential rebuild's commons fail
+    _, iou = measured(program, part, target, result.iou)
+    assert iou >= 0.9999
