@@ -29,6 +29,7 @@ from zonegraph.configs import InferConfig
 from zonegraph.data.targets import load_target, target_region
 from zonegraph.export.verify import Export, run_script, verified_export
 from zonegraph.export.writers import write_outputs
+from zonegraph.geometry.occ import self_intersects
 from zonegraph.sequence.best_first import SearchConfig, SearchResult, search
 from zonegraph.sequence.deadline import Deadline
 from zonegraph.sequence.diagnosis import Diagnosis, diagnose
@@ -271,12 +272,16 @@ def _export_fields(export: Export | None) -> dict[str, Any]:
 
 def _disagreement(rebuilt: Shape | None, target: Shape, iou: float) -> str:
     """Why a program exact on zones is not exact as a B-rep, for ``result.json``: the rebuild or
-    the Booleans measuring it failed (a zone-exact program's prisms are the target's zones)."""
+    the Booleans measuring it failed (a zone-exact program's prisms are the target's zones), or
+    the target itself is a shape no Boolean handles."""
     volume = rebuilt.volume / target.volume if rebuilt is not None and target.volume else 0.0
-    return (
-        f"exact on zones but rebuilt to B-rep IoU {iou:.6g} (volume {volume:.6g} of the target's): "
-        "an OpenCASCADE Boolean of the rebuild or of the IoU failed"
+    cause = (
+        "the target's own faces cross each other (OpenCASCADE's Boolean check), so no Boolean "
+        "with it can be trusted"
+        if self_intersects(target.wrapped)
+        else "an OpenCASCADE Boolean of the rebuild or of the IoU failed"
     )
+    return f"exact on zones but rebuilt to B-rep IoU {iou:.6g} (volume {volume:.6g} of the target's): {cause}"
 
 
 def _why_not_exact(

@@ -8,6 +8,7 @@ import pytest
 
 from zonegraph.configs import InferConfig
 from zonegraph.data.replay import as_shape
+from zonegraph.geometry.occ import self_intersects
 from zonegraph.geometry.shapes import write_brep
 from zonegraph.reconstruction import infer
 from zonegraph.sequence.best_first import SearchConfig, search
@@ -119,3 +120,15 @@ def test_a_program_whose_commons_with_the_target_fail_is_measured_on_its_cells()
     assert brep_iou(part, target) < 0.5  # the sequential rebuild's commons fail
     _, iou = measured(program, part, target, result.iou)
     assert iou >= 0.9999
+
+
+def test_a_target_whose_own_faces_cross_is_named_as_the_cause(tmp_path):
+    """The corpus part's cylinder crosses its own end cap (OpenCASCADE's Boolean check): every
+    common with it is empty, a copy of itself included, so the zone-exact program cannot be
+    measured, and the result says the target is why."""
+    part = corpus_shape("06_11to15ops/batch_004.py", "42329_df7f540f_0060")
+    assert self_intersects(part.wrapped)
+    assert not self_intersects(corpus_shape("05_8to10ops/batch_003.py", "21803_8a36dcda_0017").wrapped)
+    result = infer(write_brep(part, tmp_path / "target.brep"), tmp_path / "out", WORK, render=False)
+    assert result.iou_zone == 1.0 and result.status == "rebuild_failed"
+    assert "the target's own faces cross each other" in result.rebuild_error

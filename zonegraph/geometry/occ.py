@@ -7,6 +7,7 @@ from typing import TypeVar
 
 import numpy as np
 from OCP.Bnd import Bnd_Box
+from OCP.BOPAlgo import BOPAlgo_ArgumentAnalyzer
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepAlgoAPI import BRepAlgoAPI_BooleanOperation, BRepAlgoAPI_Common, BRepAlgoAPI_Fuse
 from OCP.BRepBndLib import BRepBndLib
@@ -116,6 +117,18 @@ def boolean_of(
     if not operation.IsDone():
         raise ValueError("fuzzy Boolean failed")
     return operation.Shape()
+
+
+def self_intersects(shape: TopoDS_Shape) -> bool:
+    """Whether OpenCASCADE's Boolean argument check finds faces of ``shape`` crossing each other
+    elsewhere than at shared edges. Such a shape passes the validity checker, yet its Booleans
+    are unreliable: a corpus target whose cylinder crossed its own end cap had every common
+    empty, with a copy of itself too."""
+    analyzer = BOPAlgo_ArgumentAnalyzer()
+    analyzer.SetShape1(shape)
+    analyzer.SelfInterMode = True
+    analyzer.Perform()
+    return bool(analyzer.HasFaulty())
 
 
 def shape_index(shape: TopoDS_Shape, kind: TopAbs_ShapeEnum) -> ShapeIndex:
