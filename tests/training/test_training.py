@@ -155,17 +155,7 @@ def test_training_reads_only_the_shards_the_labels_records_list_as_ok_and_intact
 @requires_samples
 def test_training_logs_to_mlflow_and_the_network_guides_search(labelled, tmp_path, monkeypatch, samples_dir):
     monkeypatch.chdir(tmp_path)
-    config = TrainConfig(
-        labels_dir=str(labelled / "labels"),
-        graphs_dir=str(labelled / "graphs"),
-        out_dir="models",
-        epochs=2,
-        val_fraction=0.34,
-        points_per_zone=16,
-        batch_states=4,
-        seed=0,
-        device="cpu",
-    )
+    config = _quick(labelled, out_dir="models", epochs=2, seed=0)
     best = train(config)
     metrics = json.loads((tmp_path / "models" / "best.json").read_text())
     assert metrics["epoch"] == best["epoch"] and 0 < metrics["val_rank"] <= 1
@@ -373,17 +363,8 @@ def test_a_stopped_run_resumes_from_its_last_epoch_in_the_same_mlflow_run(labell
     from zonegraph.sequence.features import FEATURES
 
     monkeypatch.chdir(tmp_path)
-    base = TrainConfig(
-        labels_dir=str(labelled / "labels"),
-        graphs_dir=str(labelled / "graphs"),
-        epochs=2,
-        val_fraction=0.34,
-        points_per_zone=16,
-        batch_states=2,
-        loss="listwise",
-        neutral_credit=0.3,
-        features=FEATURES,
-        rounds=1,
+    base = _quick(
+        labelled, epochs=2, batch_states=2, loss="listwise", neutral_credit=0.3, features=FEATURES, rounds=1
     )
     train(replace(base, out_dir="broken", epochs=1))
     after_one = torch.load(tmp_path / "broken" / "last.pt", weights_only=True)
