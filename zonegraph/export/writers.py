@@ -120,22 +120,29 @@ class LocalEdge:
 
 
 def _arc_through(
-    start: np.ndarray, end: np.ndarray, centre: np.ndarray, mid: np.ndarray, radius: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Centre and mid point of the arc of ``radius`` from ``start`` to ``end`` (the loop's corners,
-    which lie up to the vertex tolerance off the edge's circle) on the side of the edge's own
-    ``centre``, its mid point nearest the edge's own ``mid``. The original mid point with moved
-    ends can be collinear with them (a 0.008 cm arc of radius 2.6 whose corner sat 1.3e-5 off it:
-    "GC_MakeArcOfCircle::Value() - no result"); this arc keeps the designer's radius and bulge."""
+    start: np.ndarray, end: np.ndarray, centre: np.ndarray, mid: np.ndarray
+) -> tuple[np.ndarray, float, np.ndarray]:
+    """Centre, radius and mid point of the arc from ``start`` to ``end`` (the loop's corners,
+    which lie up to the vertex tolerance off the edge's circle) whose centre is the edge's own
+    ``centre`` moved onto the corners' bisector, its mid point nearest the edge's own ``mid``.
+
+    The original mid point with moved ends can be collinear with them (a 0.008 cm arc of radius
+    2.6 whose corner sat 1.3e-5 off it: "GC_MakeArcOfCircle::Value() - no result"). Keeping the
+    radius and solving for the centre from the chord instead is ill-conditioned on a half circle:
+    a corpus semicircle of radius 4 whose corners sat 1.8e-5 off it has a chord longer than its
+    diameter, and was written about its chord's midpoint, 0.006 cm off (the part lost 2.4e-4 of
+    its volume). Moving the centre onto the bisector shifts it by no more than the corners moved
+    relative to the chord's length, whatever the arc's sweep."""
     half = (end - start) / 2
     chord = float(np.linalg.norm(half[:2]))
     if chord == 0.0:
-        return centre, mid
-    normal = np.array([-half[1], half[0], 0.0]) / chord
-    side = 1.0 if float((centre - (start + half)) @ normal) >= 0 else -1.0
-    new_centre = start + half + side * math.sqrt(max(radius**2 - chord**2, 0.0)) * normal
+        return centre, float(np.linalg.norm((mid - centre)[:2])), mid
+    along = np.array([half[0], half[1], 0.0]) / chord
+    middle = start + half
+    new_centre = centre - float((centre - middle) @ along) * along
+    radius = float(np.linalg.norm((start - new_centre)[:2]))
     out = mid - new_centre
-    return new_centre, new_centre + radius * out / np.linalg.norm(out)
+    return new_centre, radius, new_centre + radius * out / np.linalg.norm(out)
 
 
 def _bulge(start: np.ndarray, mid: np.ndarray, end: np.ndarray) -> float:
@@ -160,14 +167,14 @@ def _arc(piece: LoopEdge, frame: Frame, snap: Snapper) -> LocalEdge:
     each snapped like any other number; the JSON's reference direction is a snapped unit vector."""
     edge = piece.edge
     start, end = (_local(frame, q) for q in (piece.start, piece.end))
-    raw_centre, raw_mid = _arc_through(
-        start, end, _local(frame, edge.arc_center), _local(frame, edge.position_at(0.5)), edge.radius
+    raw_centre, raw_radius, raw_mid = _arc_through(
+        start, end, _local(frame, edge.arc_center), _local(frame, edge.position_at(0.5))
     )
     if _bulge(start, raw_mid, end) <= snap.tol:
         return _line(start, end, snap)  # straight within what a number may move; snapped, no arc
     points = [snap.point(start), snap.point(raw_mid), snap.point(end)]
     centre = snap.point(raw_centre)
-    radius = snap.length(edge.radius)
+    radius = snap.length(raw_radius)
     a, m, b = (q - centre for q in points)
     sign = 1.0 if a[0] * m[1] - a[1] * m[0] > 0 else -1.0
     ref = snap.direction(a)
