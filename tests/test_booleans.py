@@ -6,13 +6,21 @@ import pytest
 from build123d import Box, Edge, Face, Pos, Shape, Solid, Vector
 from OCP.BRep import BRep_Builder
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Common, BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
-from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_Copy,
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeFace,
+    BRepBuilderAPI_MakeWire,
+)
+from OCP.GC import GC_MakeSegment
+from OCP.gp import gp_Pln, gp_Pnt
 from OCP.ShapeAnalysis import ShapeAnalysis_ShapeTolerance
 from OCP.TopAbs import TopAbs_INTERNAL
-from OCP.TopoDS import TopoDS, TopoDS_Shell, TopoDS_Solid, TopoDS_Wire
+from OCP.TopoDS import TopoDS, TopoDS_Shell, TopoDS_Solid, TopoDS_Vertex, TopoDS_Wire
 
 from zonegraph.geometry.occ import (
     fuzzy_boolean,
+    gaps_closed,
     overlaps_merged,
     precise_volume,
     without_internal_wires,
@@ -96,3 +104,30 @@ def test_overlapping_solids_are_merged_and_touching_or_apart_ones_kept():
     volumes = sorted(precise_volume(s) for s in merged)
     assert volumes == pytest.approx([1, 1, 1.75])
     assert merged[1] is touching.wrapped and merged[2] is apart.wrapped
+
+
+def _gapped_rectangle() -> Face:
+    """A 4 x 3 rectangle whose right edge runs 0.01 right of both of its vertices, which their
+    tolerance of 0.02 covers: valid, as partition faces with such gaps are."""
+    vertices = []
+    for x, y in [(0, 0), (4, 0), (4, 3), (0, 3)]:
+        v = TopoDS_Vertex()
+        BRep_Builder().MakeVertex(v, gp_Pnt(x, y, 0), 0.02)
+        vertices.append(v)
+    curves = [((0, 0), (4, 0)), ((4.01, 0), (4.01, 3)), ((4, 3), (0, 3)), ((0, 3), (0, 0))]
+    wire = BRepBuilderAPI_MakeWire()
+    for i, (a, b) in enumerate(curves):
+        segment = GC_MakeSegment(gp_Pnt(*a, 0), gp_Pnt(*b, 0)).Value()
+        wire.Add(BRepBuilderAPI_MakeEdge(segment, vertices[i], vertices[(i + 1) % 4]).Edge())
+    return Face(BRepBuilderAPI_MakeFace(gp_Pln(), wire.Wire(), True).Face())
+
+
+def test_a_face_whose_curves_miss_its_vertices_sweeps_a_sound_prism_once_its_gaps_are_closed():
+    face = _gapped_rectangle()
+    depth = Vector(0, 0, 2)
+    assert face.is_valid
+    assert Solid.extrude(face, depth).volume != pytest.approx(2 * face.area, rel=1e-4)
+    healed = Face(gaps_closed(face.wrapped))
+    assert healed.is_valid
+    assert Solid.extrude(healed, depth).volume == pytest.approx(2 * healed.area, rel=1e-9)
+    assert 12.0 - 1e-9 <= healed.area <= face.area
