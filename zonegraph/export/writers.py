@@ -120,29 +120,72 @@ class LocalEdge:
 
 
 def _arc_through(
-    start: np.ndarray, end: np.ndarray, centre: np.ndarray, mid: np.ndarray
+    start: np.ndarray, end: np.ndarray, centre: np.ndarray, curve: np.ndarray
 ) -> tuple[np.ndarray, float, np.ndarray]:
     """Centre, radius and mid point of the arc from ``start`` to ``end`` (the loop's corners,
-    which lie up to the vertex tolerance off the edge's circle) whose centre is the edge's own
-    ``centre`` moved onto the corners' bisector, its mid point nearest the edge's own ``mid``.
+    which lie up to the vertex tolerance off the edge's circle) that stays nearest the edge's own
+    ``curve`` (points along it, its mid point in the middle): of the circles through both
+    corners, whose centres lie on their bisector, the first among :func:`_bisector_centres` that
+    the curve's points miss by no more than the least miss and what the corners miss the edge's
+    own circle by (so a short arc keeps its designer's radius: every circle through its corners
+    follows it about as well).
 
-    The original mid point with moved ends can be collinear with them (a 0.008 cm arc of radius
-    2.6 whose corner sat 1.3e-5 off it: "GC_MakeArcOfCircle::Value() - no result"). Keeping the
-    radius and solving for the centre from the chord instead is ill-conditioned on a half circle:
-    a corpus semicircle of radius 4 whose corners sat 1.8e-5 off it has a chord longer than its
-    diameter, and was written about its chord's midpoint, 0.006 cm off (the part lost 2.4e-4 of
-    its volume). Moving the centre onto the bisector shifts it by no more than the corners moved
-    relative to the chord's length, whatever the arc's sweep."""
+    No one construction suits every arc. Keeping the edge's radius and solving for the centre
+    from the chord is ill-conditioned on a half circle: a corpus semicircle of radius 4 whose
+    corners sat 1.8e-5 off it has a chord longer than its diameter, and was written about its
+    chord's midpoint, 0.006 cm off (the part lost 2.4e-4 of its volume). The circle through the
+    corners and the edge's mid point degenerates on a short arc (a 0.008 cm arc of radius 2.6
+    whose corner sat 1.3e-5 off it: "GC_MakeArcOfCircle::Value() - no result")."""
+    mid = curve[len(curve) // 2]
     half = (end - start) / 2
     chord = float(np.linalg.norm(half[:2]))
     if chord == 0.0:
-        return centre, float(np.linalg.norm((mid - centre)[:2])), mid
-    along = np.array([half[0], half[1], 0.0]) / chord
+        return centre, _radius(centre, mid), mid
     middle = start + half
-    new_centre = centre - float((centre - middle) @ along) * along
-    radius = float(np.linalg.norm((start - new_centre)[:2]))
+    normal = np.array([-half[1], half[0], 0.0]) / chord
+
+    def miss(offset: float) -> float:
+        radii = np.linalg.norm((curve - (middle + offset * normal))[:, :2], axis=1)
+        return float(np.max(np.abs(radii - math.hypot(chord, offset))))
+
+    offsets = _bisector_centres(middle, normal, chord, centre, mid)
+    misses = [miss(o) for o in offsets]
+    slack = max(abs(float(np.linalg.norm((q - centre)[:2])) - _radius(centre, mid)) for q in (start, end))
+    offset = next(o for o, m in zip(offsets, misses, strict=True) if m <= min(misses) + slack)
+    new_centre = middle + offset * normal
+    radius = math.hypot(chord, offset)
     out = mid - new_centre
     return new_centre, radius, new_centre + radius * out / np.linalg.norm(out)
+
+
+def _radius(centre: np.ndarray, point: np.ndarray) -> float:
+    return float(np.linalg.norm((point - centre)[:2]))
+
+
+def _bisector_centres(
+    middle: np.ndarray,
+    normal: np.ndarray,
+    chord: float,
+    centre: np.ndarray,
+    mid: np.ndarray,
+) -> list[float]:
+    """Offsets along the corners' bisector (from the chord's middle) of three centres: the edge's
+    own centre moved onto it; the centre at the edge's radius on the own centre's side; the
+    centre of the circle through the corners and the edge's mid point, where they are not
+    collinear."""
+    own = float((centre - middle) @ normal)
+    radius = _radius(centre, mid)
+    out = [own, math.copysign(math.sqrt(max(radius**2 - chord**2, 0.0)), own)]
+    to_mid = (mid - middle)[:2]
+    across = float(to_mid @ normal[:2])
+    if abs(across) > 1e-12 * chord:
+        out.append((float(to_mid @ to_mid) - chord**2) / (2 * across))
+    return out
+
+
+# Points along an arc (an odd count: the middle one is its mid point) by which a written arc is
+# chosen (:func:`_arc_through`).
+ARC_SAMPLES = 9
 
 
 def _bulge(start: np.ndarray, mid: np.ndarray, end: np.ndarray) -> float:
@@ -167,9 +210,8 @@ def _arc(piece: LoopEdge, frame: Frame, snap: Snapper) -> LocalEdge:
     each snapped like any other number; the JSON's reference direction is a snapped unit vector."""
     edge = piece.edge
     start, end = (_local(frame, q) for q in (piece.start, piece.end))
-    raw_centre, raw_radius, raw_mid = _arc_through(
-        start, end, _local(frame, edge.arc_center), _local(frame, edge.position_at(0.5))
-    )
+    curve = np.array([_local(frame, edge.position_at(t)) for t in np.linspace(0.0, 1.0, ARC_SAMPLES)])
+    raw_centre, raw_radius, raw_mid = _arc_through(start, end, _local(frame, edge.arc_center), curve)
     if _bulge(start, raw_mid, end) <= snap.tol:
         return _line(start, end, snap)  # straight within what a number may move; snapped, no arc
     points = [snap.point(start), snap.point(raw_mid), snap.point(end)]
