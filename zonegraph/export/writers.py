@@ -150,7 +150,7 @@ def _arc_through(
 
     offsets = _bisector_centres(middle, normal, chord, centre, mid)
     misses = [miss(o) for o in offsets]
-    slack = max(abs(float(np.linalg.norm((q - centre)[:2])) - _radius(centre, mid)) for q in (start, end))
+    slack = max(abs(_radius(centre, q) - _radius(centre, mid)) for q in (start, end))
     offset = next(o for o, m in zip(offsets, misses, strict=True) if m <= min(misses) + slack)
     new_centre = middle + offset * normal
     radius = math.hypot(chord, offset)
