@@ -50,6 +50,7 @@ from zonegraph.export.idioms import named_plane, plane_code, plane_of_frame, pla
 from zonegraph.export.loops import LoopEdge, loop_edges
 from zonegraph.export.render import render_sequence
 from zonegraph.export.snap import Snapper, written
+from zonegraph.geometry.cells import MERGE_RTOL
 from zonegraph.geometry.shapes import write_step
 from zonegraph.geometry.vec import vec3
 from zonegraph.sequence.program import ProgramStep
@@ -637,13 +638,15 @@ def boolean(part, tool, mode):
 # every chain, at every fuzzy value, while one general fuse of all seven tools gave the part (IoU
 # 0.999998). As :func:`zonegraph.data.replay.cells_bodies` does for a replay: each cell of the
 # fuse is material when the last tool that holds it adds, i.e. the cells inside an adding tool and
-# outside every later tool.
+# outside every later tool. A fuse whose cells change volume when merged is passed over, as in
+# :func:`zonegraph.geometry.cells.select_cells` (a 16-step corpus program's exact fuse merged into
+# a "valid" solid of volume -1e-8).
 POINT_SET_CODE = """
 def point_set(steps):
     \"\"\"The part that steps (tool, Mode.ADD or Mode.SUBTRACT) make, in order: the pieces of one
     general fuse of all the tools that the last tool holding them adds, faces closer than each of
-    FUZZY in turn taken as one; the first valid result (shared faces merged where that keeps it
-    valid).\"\"\"
+    FUZZY in turn taken as one; the first valid result whose volume is the cells' (shared faces
+    merged where that keeps it so).\"\"\"
     tools = [BRepBuilderAPI_Copy(tool.wrapped).Shape() for tool, _ in steps]
     for fuzzy in FUZZY:
         cells = BOPAlgo_CellsBuilder()
@@ -661,11 +664,16 @@ def point_set(steps):
                 for later in tools[i + 1 :]:
                     avoid.Append(later)
                 cells.AddToResult(take, avoid, 1, False)
+        held = Part(cells.Shape()).volume
         cells.RemoveInternalBoundaries()
         part = Part(cells.Shape())
+        if abs(part.volume - held) > MERGE_RTOL * abs(held):
+            continue  # the cells' boundaries were removed wrongly at this fuzzy value
         merged = Part(BRepBuilderAPI_Copy(part.wrapped).Shape()).clean()
-        if merged.is_valid or part.is_valid:
-            return merged if merged.is_valid else part
+        if merged.is_valid and abs(merged.volume - held) <= MERGE_RTOL * abs(held):
+            return merged
+        if part.is_valid:
+            return part
     raise RuntimeError("the general fuse of the tools failed at every fuzzy value")
 """
 
@@ -688,6 +696,7 @@ def _fuzzy_step_code(
 
 
 def _fuzzy_body(steps: list[WrittenStep], unit: str, style: ScriptStyle) -> list[str]:
+    merge = f"MERGE_RTOL = {MERGE_RTOL}  # how far merging the cells may move their volume"
     imports = (
         ["from OCP.BOPAlgo import BOPAlgo_CellsBuilder"]
         if style.cells
@@ -699,6 +708,7 @@ def _fuzzy_body(steps: list[WrittenStep], unit: str, style: ScriptStyle) -> list
         "from OCP.collections import List_TopoDS_Shape",
         "",
         f"FUZZY = ({', '.join(written(f) for f in style.fuzzy)})  # {unit}",
+        *([merge] if style.cells else []),
         *(POINT_SET_CODE if style.cells else FUZZY_CODE).splitlines(),
         "",
         "steps = []" if style.cells else "part = None",
