@@ -1,10 +1,11 @@
-"""The README's headline results, written from the figure files the corpus benchmark left.
+"""The headline results of the README and the site's front page, written from the figure files
+the corpus benchmark left.
 
     python -m bench.readme [--check]
 
-The README names the figures it quotes in a marker, ``<!-- results: tuning-SHA validation-SHA
+Each page names the figures it quotes in a marker, ``<!-- results: tuning-SHA validation-SHA
 -->``, and holds the table drawn from them up to ``<!-- results: end -->``; this command redraws
-that table (``--check``: exits 1 when the README's table is not the one its figures give). The
+those tables (``--check``: exits 1 when a page's table is not the one its figures give). The
 newest figure of each sample is the one whose commit comes last in the history; a test checks
 that the README names those, so a re-run of the benchmark cannot leave an old number on the
 front page.
@@ -21,9 +22,14 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
+PAGES = (README, ROOT / "docs" / "index.md")
 FIGURES = ROOT / "docs" / "figures"
 BLOCK = re.compile(r"(<!-- results:((?:\s+[\w.-]+)+)\s*-->\n)(.*?)(<!-- results: end -->)", re.S)
-SAMPLES = {"tuning": "steered the work", "validation": "never tuned on"}
+SAMPLES = {
+    "tuning": "steered the work",
+    "validation": "never tuned on; one design opened at 6a6cb54",
+    "fresh": "never tuned on; 5 of its parts opened in earlier diagnoses",
+}
 LONG = ("06_11to15ops", "07_16to20ops")  # the folders the headline shows beside the total
 
 
@@ -69,7 +75,7 @@ def named(text: str) -> list[str]:
 
 
 def newest(sample: str) -> str | None:
-    """The figure of ``sample`` (``tuning``, ``validation``) whose commit is the newest in the
+    """The figure of ``sample`` (``tuning``, ``validation``, ``fresh``) whose commit is the newest in the
     history, or None where none of their commits is in it."""
     history = subprocess.run(["git", "rev-list", "HEAD"], cwd=ROOT, capture_output=True, text=True)
     order = history.stdout.split()
@@ -81,14 +87,18 @@ def newest(sample: str) -> str | None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--check", action="store_true", help="exit 1 if the README's table is stale")
+    parser.add_argument("--check", action="store_true", help="exit 1 if a page's table is stale")
     args = parser.parse_args()
-    text = README.read_text()
-    fresh = render(text)
+    stale = False
+    for page in PAGES:
+        text = page.read_text()
+        fresh = render(text)
+        stale |= fresh != text
+        if not args.check:
+            page.write_text(fresh)
+            print(f"{page}: results from {', '.join(named(text))}")
     if args.check:
-        sys.exit(0 if fresh == text else 1)
-    README.write_text(fresh)
-    print(f"{README}: results from {', '.join(named(text))}")
+        sys.exit(1 if stale else 0)
 
 
 if __name__ == "__main__":
