@@ -21,11 +21,9 @@ it), the validation sample is ``--seed 2023 --fresh-from 0``, a seed never used 
 figures come from parts that did not steer the work (until one of them was opened, at 6a6cb54;
 the fresh sample, ``--seed 9090 --fresh-from 0 2023``, was drawn then). Failures are diagnosed on
 other disjoint samples (``--seed 5150 --fresh-from 0 2023``), so that looking into them steers
-neither. A folder
-smaller than two samples (``08_21plus`` has 15 designs) has no fresh designs left; the table shows
-it with 0 designs. ``--against`` names the ``results.json`` of an earlier run of the same sample
-and lists every design exact there and not
-now, and the reverse.
+neither. A folder smaller than two samples (``08_21plus`` has 15 designs) has no fresh designs
+left; the table shows it with 0 designs. ``--against`` names the ``results.json`` of an earlier
+run of the same sample and lists every design exact there and not now, and the reverse.
 """
 
 from __future__ import annotations

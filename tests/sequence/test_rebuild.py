@@ -29,6 +29,17 @@ pytestmark = requires_corpus
 WORK = InferConfig(budget_s=math.inf, max_expansions=2000)  # the same search on any machine and load
 
 
+def _searched(batch: str, design_id: str, expansions: int, simplify: bool = True):
+    """A corpus part's solids, the heuristic search on its zone graph (bounded by work, not
+    seconds, so the same on any machine and load) and the program of what it found."""
+    solids = list(corpus_shape(batch, design_id).solids())
+    graph = build_zone_graph(solids, simplify=simplify, samples=0)
+    generator = ProposalGenerator(graph)
+    work = SearchConfig(budget_s=math.inf, max_expansions=expansions)
+    result = search(graph, HeuristicRanker(), work, generator)
+    return solids, result, build_program(graph, result.steps, generator)
+
+
 @pytest.mark.parametrize(
     ("batch", "design_id"),
     [
@@ -86,12 +97,9 @@ def test_a_zone_exact_program_rebuilds_where_sequential_booleans_fail(batch, des
     """The search on the graph that ``infer`` finds the program on, then the rebuild and its IoU
     (``infer`` itself spends 10 to 30 s on these before it gets there). Bounded by work, not
     seconds: each needs 7 expansions, which a 5 s budget did not always buy on a loaded machine."""
-    solids = list(corpus_shape(batch, design_id).solids())
-    graph = build_zone_graph(solids, simplify=simplify, samples=0)
-    generator = ProposalGenerator(graph)
-    result = search(graph, HeuristicRanker(), SearchConfig(budget_s=math.inf, max_expansions=50), generator)
+    solids, result, program = _searched(batch, design_id, 50, simplify)
     assert result.exact and result.iou == 1.0
-    states = execute(build_program(graph, result.steps, generator))
+    states = execute(program)
     assert brep_iou(states[-1], as_shape(solids)) >= 0.9999
 
 
@@ -114,12 +122,8 @@ def test_a_program_whose_commons_with_the_target_fail_is_measured_on_its_cells()
     """A 15-step program rebuilds to the target's volume (to 8e-7), yet every common of that
     rebuild with the target comes back empty: B-rep IoU 0 against zone IoU 0.99999998. The same
     program evaluated on the cells of its tools measures what its zones say."""
-    solids = list(corpus_shape("06_11to15ops/batch_002.py", "21732_adaf1650_0010").solids())
-    graph = build_zone_graph(solids, simplify=True, samples=0)
-    generator = ProposalGenerator(graph)
-    result = search(graph, HeuristicRanker(), SearchConfig(budget_s=math.inf, max_expansions=60), generator)
+    solids, result, program = _searched("06_11to15ops/batch_002.py", "21732_adaf1650_0010", 60)
     assert result.iou > 0.9999
-    program = build_program(graph, result.steps, generator)
     target = as_shape(solids)
     part = execute(program)[-1]
     assert brep_iou(part, target) < 0.5  # the sequential rebuild's commons fail
@@ -131,12 +135,8 @@ def test_every_prism_of_a_program_holds_its_sketch_area_times_its_depth():
     """A sketch face of the partition whose arcs end 1.3e-3 cm apart (inside a vertex tolerance of
     0.02) swept a prism 1.1e-4 short of its area times its depth, and the zone-exact program fell
     1.3e-5 short of the target; swept with its gaps closed, it holds what its zones hold."""
-    solids = list(corpus_shape("06_11to15ops/batch_002.py", "21638_0a984848_0011").solids())
-    graph = build_zone_graph(solids, simplify=True, samples=0)
-    generator = ProposalGenerator(graph)
-    result = search(graph, HeuristicRanker(), SearchConfig(budget_s=math.inf, max_expansions=400), generator)
+    solids, result, program = _searched("06_11to15ops/batch_002.py", "21638_0a984848_0011", 400)
     assert result.iou == 1.0
-    program = build_program(graph, result.steps, generator)
     for step in program:
         area = sum(f.area for f in step.faces)
         assert step.tool().volume == pytest.approx(area * step.distance, rel=1e-5)
@@ -171,12 +171,8 @@ def test_cells_whose_merge_changes_their_volume_are_passed_over():
     which merge into a solid the checker accepts of volume ~0 (the point-set script returned it:
     IoU 0); such a fuse is passed over, in the library's cells and in the script, for the next
     fuzzy value's, which gives the part."""
-    solids = list(corpus_shape("05_8to10ops/batch_005.py", "25199_d7aff7a5_0015").solids())
-    graph = build_zone_graph(solids, simplify=True, samples=0)
-    generator = ProposalGenerator(graph)
-    result = search(graph, HeuristicRanker(), SearchConfig(budget_s=math.inf, max_expansions=2000), generator)
+    solids, result, program = _searched("05_8to10ops/batch_005.py", "25199_d7aff7a5_0015", 2000)
     assert result.iou == 1.0
-    program = build_program(graph, result.steps, generator)
     target = as_shape(solids)
     script = program_script(written_steps(program), "t", Unit.CM, fuzzy_styles(target)[1])
     assert brep_iou(run_script(script), target) >= 0.9999

@@ -83,10 +83,10 @@ def select_cells(
         take = [arguments[i] for i in sorted(owners)]
         avoid = [a for i, a in enumerate(arguments) if i not in owners]
         builder.AddToResult(shape_list(take), shape_list(avoid), 1, False)
-    held = _volume(builder.Shape())
+    held = volume_props(builder.Shape())[0]
     builder.RemoveInternalBoundaries()
     raw = without_open_shells(builder.Shape())
-    if abs(_volume(raw) - held) > MERGE_RTOL * abs(held):
+    if abs(volume_props(raw)[0] - held) > MERGE_RTOL * abs(held):
         raise RuntimeError("merging the cells changed their volume")
     merged = without_open_shells(unified(raw))  # raw itself where the unifier raises
     return merged if _valid(merged) or not _valid(raw) else raw
@@ -118,10 +118,6 @@ def _cell_owners(builder: BOPAlgo_CellsBuilder, arguments: Sequence[TopoDS_Shape
                 if k > 0:
                     owners[k - 1].add(i)
     return [frozenset(o) for o in owners]
-
-
-def _volume(shape: TopoDS_Shape) -> float:
-    return volume_props(shape)[0]
 
 
 def _valid(shape: TopoDS_Shape) -> bool:
