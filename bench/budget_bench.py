@@ -2,7 +2,7 @@
 
     python -m bench.budget_bench TARGET... [--budget S] [--guide heuristic]
 
-Runs :func:`zonegraph.reconstruction.reconstruct` (what ``zonegraph infer`` searches) on each target
+Runs `zonegraph.reconstruction.reconstruct` (what ``zonegraph infer`` searches) on each target
 (STEP, BREP or design JSON), one at a time, and prints its search seconds (both graphs, generator
 set-up included: what the budget bounds) beside the budget, with the zone-graph build seconds
 apart. The goal: no search more than 10% past its budget. The last line is the worst overrun.

@@ -2,6 +2,7 @@
 
     python -m bench.docs_images [--out docs/images]
     python -m bench.docs_images --mlflow PROJECT [--out docs/images]
+    python -m bench.docs_images --site [--out docs/images]
 
 A bracket (a plate with a slot and a bored boss) is built with build123d and written as STEP;
 ``zonegraph.infer`` runs on it as ``zonegraph infer bracket.step`` would, and its strip
@@ -12,15 +13,26 @@ A bracket (a plate with a slot and a bored boss) is built with build123d and wri
 evaluated): ``mlflow ui`` on its ``mlflow.db``, as ``make ui`` serves it, opened in headless
 Chromium at the experiments list, the newest training run, its metrics, its logged model and the
 newest evaluation run with its metrics (``mlflow_*.png``, palette-reduced to stay small).
+
+``--site`` builds the documentation site as ``make docs-build`` does (``mkdocs build --strict``),
+serves the built pages over HTTP as ``make docs`` would, and photographs its getting-started page
+and its API page (``site_*.png``): what a newcomer sees, rendered by a browser rather than read as
+Markdown.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
+import http.server
+import os
 import shutil
 import subprocess
 import sys
 import tempfile
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from build123d import (
@@ -72,6 +84,12 @@ SHOTS = {  # file -> the dashboard's address (from the experiment and run ids) a
 }
 
 
+SITE_SHOTS = {  # file -> the built site's page and the shot's height
+    "site_getting_started.png": ("getting-started/", 1800),
+    "site_api.png": ("api/", 1800),
+}
+
+
 def _newest_run(url: str, experiment_id: str) -> dict:
     body = {"experiment_ids": [experiment_id], "max_results": 1, "order_by": ["start_time DESC"]}
     return rest(url, "runs/search", body)["runs"][0]
@@ -113,7 +131,7 @@ def _shoot(address: str, height: int, path: Path) -> None:
 
 
 def mlflow_shots(project: Path, out: Path) -> list[Path]:
-    """Serve ``project``'s store with ``mlflow ui`` and photograph :data:`SHOTS` into ``out``."""
+    """Serve ``project``'s store with ``mlflow ui`` and photograph `SHOTS` into ``out``."""
     subprocess.run([sys.executable, "-m", "eval.tracking", "relocate"], cwd=project, check=True)
     with mlflow_server(project, command="ui") as base:
         rest(base, "experiments/search", {"max_results": 1})  # the server is up
@@ -131,12 +149,52 @@ def mlflow_shots(project: Path, out: Path) -> list[Path]:
         return paths
 
 
+class _QuietHandler(http.server.SimpleHTTPRequestHandler):
+    """Serves files without a log line per request."""
+
+    def log_message(self, format: str, *args: object) -> None:
+        pass
+
+
+@contextmanager
+def _served(folder: Path) -> Iterator[str]:
+    """``folder`` served over HTTP on a free local port, for as long as the block runs."""
+    handler = functools.partial(_QuietHandler, directory=str(folder))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def site_shots(out: Path) -> list[Path]:
+    """Build the site with ``--strict`` into a temporary folder and photograph `SITE_SHOTS`."""
+    paths = []
+    with tempfile.TemporaryDirectory() as site:
+        env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}
+        build = [sys.executable, "-m", "mkdocs", "build", "--strict", "--quiet", "--site-dir", site]
+        subprocess.run(build, check=True, env=env)
+        with _served(Path(site)) as base:
+            for name, (page, height) in SITE_SHOTS.items():
+                _shoot(f"{base}/{page}", height, out / name)
+                paths.append(out / name)
+                print(f"wrote {out / name} ({(out / name).stat().st_size // 1024} KB)", flush=True)
+    return paths
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=Path("docs/images"))
     ap.add_argument("--mlflow", type=Path, default=None, help="photograph this project's MLflow runs instead")
+    ap.add_argument("--site", action="store_true", help="photograph the built documentation site instead")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
+    if args.site:
+        site_shots(args.out.resolve())
+        return
     if args.mlflow is not None:
         mlflow_shots(args.mlflow.resolve(), args.out.resolve())
         return

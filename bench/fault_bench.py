@@ -163,7 +163,7 @@ def gt_and_labels(brep_dir: str, graph_dir: str, operations: str, design_id: str
 
 
 def _job(project: Path, stage: str, design: str, kill: dict[str, str], *parts: Any, **kw: Any) -> Job:
-    """A stage's job for one design, its body wrapped in :func:`_killing`."""
+    """A stage's job for one design, its body wrapped in `_killing`."""
     flag = kill.get(f"{stage}/{design}", str(project / "no-flag"))
     fn, args, outputs = kw.pop("body"), kw.pop("args"), kw["outputs"]
     return Job(design, fingerprint(*parts, files=kw["inputs"]), (flag, outputs, fn, *args), **kw)

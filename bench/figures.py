@@ -297,7 +297,7 @@ REPORT_TIMES = (0.5, 1.0, 5.0, 20.0)  # the search seconds the evaluation's figu
 
 def _curve_points(curves: pd.DataFrame) -> dict:
     """Per guide: designs, and mean IoU and exact rate at each of REPORT_TIMES, read as the
-    report reads them (:func:`eval.curves.at_time`)."""
+    report reads them (`eval.curves.at_time`)."""
     out = {}
     for guide, group in curves.groupby("guide", sort=False):
         points = {}

@@ -9,7 +9,7 @@ Searches the saved (simplified) zone graph of a seeded sample of test designs, s
 timeline folder and none of a project any checkpoint trained on, once per guide and budget, in
 this one process (the ranker is made per search, then the graph is read, so a network's
 per-graph encoding counts inside the budget, as in ``zonegraph infer``). A guide
-``net=PATH@top_m=M,blend=B`` is the :class:`~zonegraph.network.ranker.NetworkRanker` with those
+``net=PATH@top_m=M,blend=B`` is the `NetworkRanker` with those
 knobs. Exact here is zone-exact (the search's own test, before the B-rep rebuild), so the figures
 isolate the search's ordering and scoring cost. On a shared machine wall seconds stretch with the
 load, so each search also records the process CPU seconds it used and its expansions

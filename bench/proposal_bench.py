@@ -10,7 +10,7 @@ in ``--exclude`` are never drawn: that sample only measures). Each design is pre
 own killable process (replay, simplified zone graph, ground-truth tools mapped onto zones) and the
 prepared zone graph and GT steps are cached under ``--cache``, so that a change of the proposal
 rules is measured on the same geometry without rebuilding it. Then, for each design, a fresh
-:class:`ProposalGenerator` walks the GT path: at every C_{i-1} it times ``proposals`` and checks
+`ProposalGenerator` walks the GT path: at every C_{i-1} it times ``proposals`` and checks
 whether the GT step (its zone set and operation) is among them. Prints, by folder: GT steps
 captured / mappable steps (the steps a proposal could have: mapped, not an intersect, changing the
 canvas), first steps captured, designs with every step captured, proposals per state (mean, max)
@@ -53,7 +53,7 @@ class Prepared:
 def prepare(path: str) -> dict:
     """Replay ``path``, build its simplified zone graph and map every GT tool onto it.
 
-    Returns :class:`Prepared`'s fields as a dict: the cache must unpickle whichever module runs."""
+    Returns `Prepared`'s fields as a dict: the cache must unpickle whichever module runs."""
     from zonegraph.data.design import load_design
     from zonegraph.data.replay import replay
     from zonegraph.zones.build import build_zone_graph

@@ -6,9 +6,9 @@ how far our replay is from Fusion's published figures.
 
 A seeded sample with the same number of designs from every timeline folder (``bench.corpus_bench``'s
 ``sample``). Each design is converted in its own killable child, as ``zonegraph convert`` does
-(:func:`zonegraph.jobs.convert_isolated`), and each converted JSON goes through ``zonegraph replay``
+(`zonegraph.jobs.convert_isolated`), and each converted JSON goes through ``zonegraph replay``
 with its defaults (the command's own code, in this process: ``zonegraph.cli.main``), which exits 0
-only when the replay reproduces the file's ``properties`` (:mod:`zonegraph.verified`). Prints the
+only when the replay reproduces the file's ``properties`` (`zonegraph.verified`). Prints the
 exit codes and the replay-vs-Fusion table (relative volume and area differences: how many above
 1e-6, by decade); writes ``results.json`` (a row per design) and ``results.md`` under ``--out``.
 """

@@ -67,7 +67,7 @@ def curves(results: pd.DataFrame, times: np.ndarray) -> pd.DataFrame:
 
 
 def at_time(curve: pd.DataFrame, seconds: float) -> pd.Series:
-    """The row of one guide's curve (:func:`curves`) whose time is nearest ``seconds``: how the
+    """The row of one guide's curve (`curves`) whose time is nearest ``seconds``: how the
     report and its figures read a curve at a mark."""
     return curve.iloc[int(np.argmin(np.abs(curve["seconds"].to_numpy() - seconds)))]
 

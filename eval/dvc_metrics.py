@@ -3,8 +3,8 @@
 ``dvc metrics show`` draws one column per key of every metrics file, so a stage that writes its
 own flat or nested keys widens every row by a column that is a dash for all the other stages
 (before this, 82 columns). Each stage's file in ``data/metrics/`` (one per guide for ``evaluate``
-and ``reconstruct``) therefore holds only :data:`SHARED`, plus a stage's one or two headline
-figures from :data:`HEADLINE`; its breakdowns (by status, by folder, by coverage category, the
+and ``reconstruct``) therefore holds only `SHARED`, plus a stage's one or two headline
+figures from `HEADLINE`; its breakdowns (by status, by folder, by coverage category, the
 runner's retries) go to ``data/details/<stage>.json``, declared in ``dvc.yaml`` as a plain
 output, not as a metric, and outside ``data/metrics`` so that ``dvc metrics show data/metrics``
 shows the metrics alone. ``docs/pipeline.md`` lists which key went where.
@@ -35,7 +35,7 @@ def median(values: Iterable[float | None]) -> float | None:
 
 
 def headline(designs: int, ok: int, seconds: Iterable[float | None], **figures: float | None) -> dict:
-    """The shared keys of a metrics file, and the ``figures`` (names of :data:`HEADLINE`)."""
+    """The shared keys of a metrics file, and the ``figures`` (names of `HEADLINE`)."""
     unknown = set(figures) - set(HEADLINE)
     if unknown:
         raise ValueError(f"not headline metrics: {sorted(unknown)} (known: {', '.join(HEADLINE)})")

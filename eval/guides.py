@@ -1,6 +1,6 @@
 """Guides named on a command line: ``heuristic``, ``random``, or a network with its search knobs.
 
-``net=PATH@top_m=M,blend=B,margin=D`` is the :class:`~zonegraph.network.ranker.NetworkRanker` of
+``net=PATH@top_m=M,blend=B,margin=D`` is the `NetworkRanker` of
 the checkpoint at PATH (the shipped scorer when PATH is empty) with those knobs, so the rank
 evaluation and the search benchmarks compare the same network under several settings.
 """

@@ -112,7 +112,7 @@ COLUMNS = ["guide", "design_id", "step", "proposals", "above", "ties", *METRICS]
 
 
 def place_row(guide: str, state: RankState, place: GTPlace) -> dict[str, Any]:
-    """One ranked step: the GT's place and every scale of it (:data:`METRICS`)."""
+    """One ranked step: the GT's place and every scale of it (`METRICS`)."""
     return {
         "guide": guide,
         "design_id": state.design_id,
@@ -135,10 +135,10 @@ def guide_ranks(
     split: str | None = "test",
     designs: Sequence[str] | None = None,
 ) -> pd.DataFrame:
-    """One row per (guide, design, step): the GT's place on every scale (:data:`COLUMNS`).
+    """One row per (guide, design, step): the GT's place on every scale (`COLUMNS`).
 
     A step whose GT is the only proposal gets a row (``proposals`` 1) without asking the guide:
-    :func:`summarise` counts it and leaves it out of the means."""
+    `summarise` counts it and leaves it out of the means."""
     rows = []
     for graph, states in rank_states(labels_dir, graphs_dir, split, designs, singles=True):
         for name, ranker in guides.items():
@@ -153,7 +153,7 @@ def guide_ranks(
 
 def make_guides(names: Sequence[str], models: Sequence[str | Path] = (), seed: int = 0) -> dict[str, Ranker]:
     """Rankers by guide name, plus one network guide per model checkpoint (named by its file),
-    which may carry the guide's knobs: ``PATH@top_m=8,blend=0.3`` (:mod:`eval.guides`)."""
+    which may carry the guide's knobs: ``PATH@top_m=8,blend=0.3`` (`eval.guides`)."""
     guides = {name: make_ranker(name, seed) for name in names}
     for model in models:
         spec = GuideSpec.parse(f"net={model}")
@@ -200,7 +200,7 @@ def bootstrap_means(
 def bootstrap_mean(
     ranks: pd.DataFrame, level: float = 0.9, samples: int = 2000, seed: int = 0, column: str = "rank"
 ) -> tuple[float, float, float]:
-    """The mean of one column over steps with its interval (see :func:`bootstrap_means`)."""
+    """The mean of one column over steps with its interval (see `bootstrap_means`)."""
     return bootstrap_means(ranks, [column], level, samples, seed)[column]
 
 
@@ -211,7 +211,7 @@ def ranked(ranks: pd.DataFrame) -> pd.DataFrame:
 
 def summarise(ranks: pd.DataFrame, level: float = 0.9, seed: int = 0) -> pd.DataFrame:
     """Per guide: designs, ranked steps, single-proposal steps left out, and every metric of
-    :data:`METRICS` with its bootstrap interval (``rank``, ``ci_low``, ``ci_high`` for rank / P;
+    `METRICS` with its bootstrap interval (``rank``, ``ci_low``, ``ci_high`` for rank / P;
     ``<metric>``, ``<metric>_ci_low``, ``<metric>_ci_high`` for the others)."""
     rows = []
     for guide, group in ranks.groupby("guide", sort=False):

@@ -356,7 +356,7 @@ def extras_section(args: argparse.Namespace, out: Path) -> str:
 
 
 def _parser() -> argparse.ArgumentParser:
-    """The command line; every default is :class:`EvalConfig`'s."""
+    """The command line; every default is `EvalConfig`'s."""
     d = EvalConfig.defaults()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", nargs="*", default=d["model"], help="network checkpoints to evaluate")

@@ -2,7 +2,7 @@
 
 In place of the paper's perceptual study, a reader compares the sequences themselves: green is a
 union, red a subtraction, grey the shape before the step. Every row is a Fusion-format design
-replayed by :func:`zonegraph.data.replay.replay`: the ground truth's own JSON and the
+replayed by `zonegraph.data.replay.replay`: the ground truth's own JSON and the
 ``sequence.json`` each search wrote, so all rows are drawn by the same code at one scale.
 """
 

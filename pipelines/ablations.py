@@ -9,7 +9,7 @@ and combined, ranked on held-out designs.
 
 A variant is a ``+``-joined list of changes to the ``train`` section of the params (the ``base``):
 ``focal`` / ``listwise`` (the objective), ``features`` / ``no_features`` (every proposal feature of
-:data:`~zonegraph.sequence.features.FEATURES`, or none), ``late`` / ``early`` (the fusion),
+`FEATURES`, or none), ``late`` / ``early`` (the fusion),
 ``points`` / ``no_points`` (the zones' point geometry), ``roundsN``, ``hiddenN`` (the width of
 every layer) and ``teacher`` (the listwise target shared with ``--teacher``'s scores: a student
 distilled from a trained checkpoint); e.g. ``listwise+features+early`` or
@@ -55,7 +55,7 @@ CHANGES: dict[str, dict[str, Any]] = {  # a variant's tokens, as overrides of th
 
 
 def variant(base: TrainConfig, spec: str, teacher: str | None = None) -> TrainConfig:
-    """The base with the changes of ``spec`` (``base``, or tokens of :data:`CHANGES`, ``roundsN``,
+    """The base with the changes of ``spec`` (``base``, or tokens of `CHANGES`, ``roundsN``,
     ``hiddenN`` and ``teacher`` joined by ``+``); an unknown token exits with one line."""
     config = base
     for token in spec.split("+"):

@@ -10,7 +10,7 @@
 ``data/designs/index.parquet`` (design id, path, split, folder: the timeline-length bucket),
 ``stats.json``/``stats.txt`` beside the published statistics and, for the corpus,
 ``conversion.parquet`` (every design with its status and reason), ``data/metrics/conversion.json``
-(:mod:`eval.dvc_metrics`' shared keys) and its breakdowns in ``data/details/conversion.json``.
+(`eval.dvc_metrics`' shared keys) and its breakdowns in ``data/details/conversion.json``.
 """
 
 from __future__ import annotations

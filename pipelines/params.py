@@ -1,10 +1,10 @@
 """The pipeline's sections of ``params.yaml`` (the single source of every seed, size and budget).
 
-Each section a stage reads is one :class:`~zonegraph.configs.Config`: the stage gets it with
-:func:`section`, which reads the file with the package's one reader and fails in one line naming
+Each section a stage reads is one `Config`: the stage gets it with
+`section`, which reads the file with the package's one reader and fails in one line naming
 the file on a key that is not a field (a typo would otherwise leave a setting at its default).
-The ``zonegraph`` and ``reconstruct`` sections are the CLI's :class:`BuildConfig` and
-:class:`InferConfig` plus the stage's own keys; ``train`` is ``training.train.TrainConfig`` and
+The ``zonegraph`` and ``reconstruct`` sections are the CLI's `BuildConfig` and
+`InferConfig` plus the stage's own keys; ``train`` is ``training.train.TrainConfig`` and
 ``evaluate`` is ``eval.report.EvalConfig``, read by those scripts themselves.
 """
 
@@ -92,14 +92,14 @@ class ReplayParams(Config):
 
 @dataclass(frozen=True)
 class ZoneGraphParams(BuildConfig):
-    """``zonegraph``: the :class:`BuildConfig` of every graph, and ``timeout_s`` per design."""
+    """``zonegraph``: the `BuildConfig` of every graph, and ``timeout_s`` per design."""
 
     timeout_s: float = 300.0
 
 
 @dataclass(frozen=True)
 class ReconstructParams(InferConfig):
-    """``reconstruct``: the :class:`InferConfig` of every search but its guide, searched once per
+    """``reconstruct``: the `InferConfig` of every search but its guide, searched once per
     guide of ``guides`` at the same budget, with ``timeout_s`` as the hard stop per design."""
 
     guides: tuple[str, ...] = ("heuristic", "random", "net")

@@ -20,7 +20,7 @@ UPSTREAM = {  # the folders stages read, by the name of their flag
 
 
 def stage_paths(doc: str, inputs: tuple[str, ...], **outputs: str) -> argparse.Namespace:
-    """Parse a stage's command line: the upstream folders ``inputs`` (names of :data:`UPSTREAM`)
+    """Parse a stage's command line: the upstream folders ``inputs`` (names of `UPSTREAM`)
     and its ``outputs`` (flag name -> what it is), all required paths, made absolute: job paths
     built from them name the same files on a Dask worker started in any folder."""
     parser = argparse.ArgumentParser(description=doc.splitlines()[0])

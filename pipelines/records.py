@@ -5,7 +5,7 @@ deleted would carry garbage downstream as if it were current. Each record theref
 outputs with every file's size and content hash, and is reused only while all of them are intact.
 Outcomes the environment caused (a killed child, a lost worker, a timeout, a missing input on a
 worker) say nothing about the design: they are recorded but tried again on later runs, at most
-:data:`MAX_ATTEMPTS` times in all, so that a design that always crashes does not cost every run.
+`MAX_ATTEMPTS` times in all, so that a design that always crashes does not cost every run.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from typing import Any
 from zonegraph.outputs import FileHashes, hash_output
 from zonegraph.status import Status
 
-RECORD_VERSION = 2  # records without it predate output hashes (see :func:`reuse`)
+RECORD_VERSION = 2  # records without it predate output hashes (see `reuse`)
 MAX_ATTEMPTS = 3  # runs on which an environment failure is tried before it stands as final
 TRANSIENT = frozenset({Status.TIMEOUT, Status.CRASH, Status.WORKER_ERROR, Status.OUT_OF_MEMORY})
 

@@ -79,7 +79,7 @@ def stage_code(stage: str, root: str | Path = PROJECT) -> tuple[str, ...]:
     """The code a stage depends on: its ``dvc.yaml`` deps under the code roots (files or folders).
 
     ``dvc.yaml`` is the one list of a stage's code: DVC reruns the stage when it changes, and
-    :func:`code_fingerprint` hashes the same paths into every record, so that a record made by
+    `code_fingerprint` hashes the same paths into every record, so that a record made by
     other code is recomputed rather than reused."""
     root = Path(root)
     with open(root / "dvc.yaml") as f:
@@ -88,8 +88,8 @@ def stage_code(stage: str, root: str | Path = PROJECT) -> tuple[str, ...]:
 
 
 def code_fingerprint(stage: str, root: str | Path = PROJECT) -> str:
-    """A hash of all the source a stage's records depend on (see :func:`stage_code`), less the
-    :data:`MACHINERY` that only runs the jobs."""
+    """A hash of all the source a stage's records depend on (see `stage_code`), less the
+    `MACHINERY` that only runs the jobs."""
     machinery = {str(Path(root) / m) for m in MACHINERY}
     return fingerprint(stage, files=tuple(p for p in stage_code(stage, root) if p not in machinery))
 

@@ -1,5 +1,5 @@
 """Shared fixtures. The data locations, skip markers and helpers the tests import live in
-:mod:`zonegraph.testing`: a test module never imports this file or another test module."""
+`zonegraph.testing`: a test module never imports this file or another test module."""
 
 from __future__ import annotations
 

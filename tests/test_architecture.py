@@ -166,3 +166,31 @@ def test_the_layout_page_names_every_module():
         if name != "__init__" and name not in named and f"zonegraph/{name}" not in named:
             missing.append("/".join(parts))
     assert not missing, f"modules docs/layout.md does not name: {missing}"
+
+
+def test_docstrings_are_markdown():
+    """The API pages render docstrings as Markdown (mkdocstrings): a Sphinx role such as
+    ``:func:`name``` shows up on the site as raw text, so names are written as code spans."""
+    role = re.compile(r":(?:func|class|meth|attr|data|mod|exc|obj):`")
+    found = [
+        f"{path.relative_to(PACKAGE.parent)}:{n}"
+        for root in ("zonegraph", "training", "eval", "pipelines", "bench")
+        for path in sorted((PACKAGE.parent / root).rglob("*.py"))
+        for n, line in enumerate(path.read_text().splitlines(), 1)
+        if role.search(line)
+    ]
+    assert not found, f"Sphinx roles in docstrings: {found}"
+
+
+def test_the_docs_snippets_name_files_that_exist():
+    """A snippet line the Markdown extension cannot parse is printed on the page as it is; every
+    line that starts like one is well formed and names a file."""
+    docs = PACKAGE.parent / "docs"
+    bad = []
+    for page in sorted(docs.rglob("*.md")):
+        for n, line in enumerate(page.read_text().splitlines(), 1):
+            if line.lstrip().startswith("--8"):
+                match = re.fullmatch(r'\s*--8<-- "([^"]+)"', line)
+                if match is None or not (PACKAGE.parent / match.group(1)).is_file():
+                    bad.append(f"{page.relative_to(docs)}:{n}: {line.strip()}")
+    assert not bad, f"malformed snippets: {bad}"

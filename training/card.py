@@ -3,7 +3,7 @@
     python -m training.card models/scorer.pt --out zonegraph/network/checkpoints/MODEL_CARD.md
         [--test-ranks eval_out/rank.json] [--note "free text"] [--top-m M] [--blend B]
 
-Everything is read from the checkpoint (:func:`training.train.save_checkpoint` stores the model
+Everything is read from the checkpoint (`training.train.save_checkpoint` stores the model
 and training configuration, the best epoch's metrics and the provenance: data version, git commit,
 MLflow run, design counts), so a card cannot drift from the weights it describes.
 """

@@ -1,9 +1,9 @@
 """Training data: the ``labels`` stage's Parquet shards and the saved zone graphs, as PyG batches.
 
 One example is one GT step of one design (a *state*): its canvas and a set of proposals with their
-labels, encoded as the search encodes a state (:mod:`zonegraph.network.encoding`) with the labels
+labels, encoded as the search encodes a state (`zonegraph.network.encoding`) with the labels
 added, and the proposal features the labels stage stored (``feat_<name>`` columns; zeros for
-shards written before them, which :attr:`LabelDataset.has_features` tells). Geometry is read from
+shards written before them, which `LabelDataset.has_features` tells). Geometry is read from
 each saved graph once, when the dataset is built, keeping ``points_per_zone`` of its surface
 samples (seeded).
 """
@@ -45,7 +45,7 @@ class _State:
 
 class LabelDataset(Dataset):
     """States from the label shards of ``labels_dir`` whose designs are in ``design_ids``: only
-    the shards the labels stage lists as ok and intact (:func:`training.shards.label_shards`).
+    the shards the labels stage lists as ok and intact (`training.shards.label_shards`).
 
     ``mode="train"`` keeps positives and negatives only (the focal loss ignores neutrals; with
     ``neutrals`` the neutrals too, for a listwise loss that gives them partial credit) and at most

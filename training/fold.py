@@ -3,7 +3,7 @@
     python -m training.fold models/scorer.pt [--out models/scorer.npz]
 
 Writes the late-fusion scorer's weights with every BatchNorm folded in, its samples per zone and
-its search defaults (:mod:`zonegraph.network.folded`) beside the checkpoint, or to ``--out``.
+its search defaults (`zonegraph.network.folded`) beside the checkpoint, or to ``--out``.
 The shipped ``zonegraph/network/checkpoints/scorer.npz`` is this command's output for the
 shipped ``scorer.pt``; a test keeps the two equal.
 """

@@ -9,7 +9,7 @@ list; the listwise loss trains that directly.
 
 A trained scorer can also teach another (knowledge distillation, Hinton et al. 2015): the listwise
 target of a state then mixes the GT with the teacher's softmax over the same proposals
-(:func:`distilled_weight`), so a narrower student, cheaper in search, learns the teacher's whole
+(`distilled_weight`), so a narrower student, cheaper in search, learns the teacher's whole
 ordering and not only its first place, from fewer designs than the teacher saw.
 """
 

@@ -6,12 +6,12 @@ Designs of the labelled training split are split again by project into training 
 (``train.val_fraction``). The objective is ``train.loss``: the paper's focal loss per proposal or
 a listwise softmax over each state's proposals with the GT as target (``train.neutral_credit``
 gives neutral proposals partial credit); ``train.features`` names the proposal features the
-scorer reads beside the zones (:mod:`zonegraph.sequence.features`). Every epoch logs the
+scorer reads beside the zones (`zonegraph.sequence.features`). Every epoch logs the
 training and validation loss and the validation GT rank on every scale (rank / P, its floor,
 the normalised rank, top-1 and top-5; ``docs/evaluation.md``). The checkpoint with the best
 validation normalised rank is written to ``models/scorer.pt``, its every figure to
 ``models/best.json``; ``models/metrics.json`` holds the few keys ``dvc metrics show`` shares with
-the stages (:func:`dvc_metrics`); ``models/curve.csv`` and ``models/curve.png`` hold the learning
+the stages (`dvc_metrics`); ``models/curve.csv`` and ``models/curve.png`` hold the learning
 curves.
 
 A run resumes: every epoch also writes ``models/last.pt`` (weights, optimiser, the shuffle's
@@ -508,7 +508,7 @@ def save_checkpoint(
     model: ProposalScorer, config: TrainConfig, metrics: dict, path: Path, provenance: dict | None = None
 ) -> None:
     """Weights with everything a model card needs: configs, best metrics, data and code versions
-    (read back by :func:`zonegraph.network.checkpoint.scorer_from`)."""
+    (read back by `zonegraph.network.checkpoint.scorer_from`)."""
     torch.save(
         {
             "model": asdict(config.model),

@@ -3,13 +3,13 @@
 After Xu et al., *Inferring CAD Modeling Sequences Using Zone Graphs* (CVPR 2021). The layers,
 each a sub-package that imports only the ones before it:
 
-- :mod:`zonegraph.geometry`: OCP/build123d helpers, B-rep I/O, normalisation;
-- :mod:`zonegraph.data`: the Fusion 360 Gallery design model, exact replay, synthetic designs;
-- :mod:`zonegraph.zones`: zone graphs (face extension, general fuse, the :class:`ZoneGraph`);
-- :mod:`zonegraph.sequence`: proposals, rankers, best-first search, programs;
-- :mod:`zonegraph.export`: editable scripts, Fusion JSON, STEP and PNG;
-- on top: :mod:`zonegraph.reconstruction` (:func:`infer`), :mod:`zonegraph.cli`,
-  :mod:`zonegraph.isolation` and :mod:`zonegraph.errors` (used by every layer).
+- `zonegraph.geometry`: OCP/build123d helpers, B-rep I/O, normalisation;
+- `zonegraph.data`: the Fusion 360 Gallery design model, exact replay, synthetic designs;
+- `zonegraph.zones`: zone graphs (face extension, general fuse, the `ZoneGraph`);
+- `zonegraph.sequence`: proposals, rankers, best-first search, programs;
+- `zonegraph.export`: editable scripts, Fusion JSON, STEP and PNG;
+- on top: `zonegraph.reconstruction` (`infer`), `zonegraph.cli`,
+  `zonegraph.isolation` and `zonegraph.errors` (used by every layer).
 
 Typical use::
 

@@ -1,7 +1,7 @@
 """Many parts in one process: ``zonegraph infer`` and ``zonegraph build`` over files and folders.
 
 The caller imports the geometry kernel once; each part then runs in a forked child
-(:func:`zonegraph.isolation.run_isolated`) that inherits those modules, so a part costs its own work
+(`zonegraph.isolation.run_isolated`) that inherits those modules, so a part costs its own work
 and a fork instead of a fresh interpreter's seconds of imports. One bad part becomes a row with its
 status and one-line reason, and the batch goes on. This module itself imports nothing heavy.
 """

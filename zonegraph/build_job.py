@@ -1,6 +1,6 @@
 """The zone-graph build as one job: a target file in, a saved graph out.
 
-Apart from :mod:`zonegraph.jobs`, whose other jobs import the search and the labels, so that
+Apart from `zonegraph.jobs`, whose other jobs import the search and the labels, so that
 ``zonegraph build PART.step`` imports the kernel, the build and its storage and nothing else.
 """
 

@@ -85,7 +85,7 @@ def _fail(target: str | Path, outcome: Outcome) -> int:
 
 def _batch(job: Callable[[], BatchJob], args: argparse.Namespace) -> int | None:
     """Several targets, or a folder: each part under ``--out/<name>``, and the exit status (2 if
-    any part failed, after all of them ran). One target file: None, for :func:`_single`."""
+    any part failed, after all of them ran). One target file: None, for `_single`."""
     from zonegraph.batch import collect_parts, is_batch, run_batch
 
     if not is_batch(args.targets):

@@ -2,8 +2,8 @@
 
 This module imports nothing heavy (and nothing else of the package), so that the CLI can take its
 defaults from these dataclasses (never copying them by hand) without loading the geometry kernel
-before a command runs, and so that every layer can declare its settings as a :class:`Config`.
-It also holds the one reader of ``params.yaml`` (:func:`load_params`, :func:`load_section`),
+before a command runs, and so that every layer can declare its settings as a `Config`.
+It also holds the one reader of ``params.yaml`` (`load_params`, `load_section`),
 which the stage scripts, the training loop and the report share.
 """
 
@@ -24,7 +24,7 @@ class ConfigError(ValueError):
 
 
 class Config:
-    """Mixin for frozen dataclass configs: :meth:`from_mapping` and :meth:`defaults`."""
+    """Mixin for frozen dataclass configs: `from_mapping` and `defaults`."""
 
     @classmethod
     def from_mapping(cls: type[C], values: Mapping[str, Any], strict: bool = False) -> C:

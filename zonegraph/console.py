@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 @dataclass
 class Captured:
-    """The text printed while a :func:`captured` block ran (filled in when it ends)."""
+    """The text printed while a `captured` block ran (filled in when it ends)."""
 
     text: str = ""
 

@@ -1,9 +1,9 @@
 """Typed errors that name the input and the reason.
 
-Every user-facing failure derives from :class:`ZoneGraphError`, so the CLI and the pipeline can
+Every user-facing failure derives from `ZoneGraphError`, so the CLI and the pipeline can
 turn it into a one-line message or a manifest row without a traceback, while programming errors
 (any other exception) still surface loudly. OpenCASCADE's own exceptions are the third kind: the
-kernel failing on this input's geometry (:func:`is_kernel_error`), not a bug of ours.
+kernel failing on this input's geometry (`is_kernel_error`), not a bug of ours.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ def file_problem(path: Path) -> str | None:
 
 
 def require_file(path: Path) -> None:
-    """Raise InputError unless ``path`` is a file (:func:`file_problem`)."""
+    """Raise InputError unless ``path`` is a file (`file_problem`)."""
     problem = file_problem(path)
     if problem:
         raise InputError(str(path), problem)

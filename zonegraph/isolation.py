@@ -51,7 +51,7 @@ class Outcome:
 def classify(exc: BaseException) -> tuple[Status, str, str]:
     """``(status, one-line reason, traceback)`` of an exception raised by a job.
 
-    OpenCASCADE's exceptions (:func:`zonegraph.errors.is_kernel_error`) are failures of the kernel
+    OpenCASCADE's exceptions (`zonegraph.errors.is_kernel_error`) are failures of the kernel
     on this input's geometry: a status like any unbuildable input. Every other exception is a bug
     of ours and keeps its traceback."""
     if isinstance(exc, ZoneGraphError):
@@ -133,7 +133,7 @@ def run_isolated(
     fn: Callable, args: tuple = (), timeout: float | None = 60.0, memory_mb: int | None = None
 ) -> Outcome:
     """``fn(*args)`` in a forked child allowed ``memory_mb`` more MiB of address space (None:
-    :func:`default_memory_mb`);
+    `default_memory_mb`);
     its return value must be picklable (keep it small). ``timeout`` None runs in-process (no limit
     of either kind)."""
     memory_mb = memory_mb or default_memory_mb()
@@ -181,7 +181,7 @@ def _died(exitcode: int | None, memory_mb: int | None, seconds: float) -> Outcom
 
 def _warn_if_pool_started() -> None:
     """Warn, once, when the kernel's thread pool has a worker thread a child would wait for (a
-    parallel Boolean ran before :mod:`zonegraph.geometry.kernel` was imported)."""
+    parallel Boolean ran before `zonegraph.geometry.kernel` was imported)."""
     global _POOL_CHECKED
     if _POOL_CHECKED or "OCP" not in sys.modules:
         return

@@ -3,7 +3,7 @@ returns only small plain data (the geometry goes to files).
 
 The design replay and the corpus converter need build123d, which a zone-graph build does not, so
 their modules are imported by the jobs that use them: ``zonegraph build PART.step`` stays on OCP.
-The build's own job lives in :mod:`zonegraph.build_job` (named here too), as this module's other
+The build's own job lives in `zonegraph.build_job` (named here too), as this module's other
 jobs import the search and the labels, which a build does not need.
 """
 
@@ -187,7 +187,7 @@ def convert_isolated(
     timeout: float = 120.0,
     memory_mb: int | None = None,
 ) -> ConvertedDesign:
-    """:func:`convert_design` in a forked child killed after ``timeout`` seconds and allowed
+    """`convert_design` in a forked child killed after ``timeout`` seconds and allowed
     ``memory_mb`` more MiB: the design's endless C call, ``os._exit``, segfault or unbounded
     allocation becomes a ``timeout``, ``crash`` or ``out_of_memory`` row, and a bug of ours a
     ``bug`` row (its traceback the first of its ``notes``)."""

@@ -3,8 +3,8 @@
 ``import zonegraph`` must not load the geometry kernel, ``import zonegraph.network`` not torch,
 ``import zonegraph.testing`` not pytest; yet each package lists its public API at the top. A
 package names where each public name lives and takes its module ``__getattr__`` and ``__dir__``
-from :func:`lazy_exports`; such first uses, and the CLI's, import the kernel :func:`uncollected`.
-Like :mod:`zonegraph.errors`, this module imports nothing of the package and serves every layer.
+from `lazy_exports`; such first uses, and the CLI's, import the kernel `uncollected`.
+Like `zonegraph.errors`, this module imports nothing of the package and serves every layer.
 """
 
 from __future__ import annotations

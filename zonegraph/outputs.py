@@ -3,7 +3,7 @@ into place only when it succeeded.
 
 Before this, an ``infer`` stopped at its timeout left ``sequence.py``, ``sequence.json`` and
 ``steps/00.step`` without a ``result.json``, and an earlier run's ``result.json`` in the same folder
-stayed as if it were current. Now each completed run lists what it wrote in :data:`LISTING`; the
+stayed as if it were current. Now each completed run lists what it wrote in `LISTING`; the
 next run into the same folder first removes exactly those entries (never a file it did not write),
 so after a failure the folder holds nothing that looks current, and after a success only the new
 run's files.
@@ -13,7 +13,7 @@ an ``flock`` the kernel drops when the holder dies, removed when the run ends) a
 line, instead of two runs mixing their files. Whoever holds the lock also removes the scratch
 folders that killed runs left.
 
-:func:`hash_output` is the one definition of an output's content (each file's size and SHA-1):
+`hash_output` is the one definition of an output's content (each file's size and SHA-1):
 the pipeline's records name their outputs with it and training checks label shards against it.
 """
 

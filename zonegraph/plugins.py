@@ -1,10 +1,10 @@
 """The guides a search can rank proposals with: the built-in ones, the network guide zonegraph
 ships, and those other packages add through an entry-point group.
 
-Kept apart from :mod:`zonegraph.sequence.rankers` and free of heavy imports, so that the CLI can
+Kept apart from `zonegraph.sequence.rankers` and free of heavy imports, so that the CLI can
 reject an unknown guide before it loads the geometry kernel, and a batch can import a guide's
 package once in the parent instead of once in every forked child. The network guide
-(:mod:`zonegraph.network`) is named here by reference, as an entry point would be. Its shipped
+(`zonegraph.network`) is named here by reference, as an entry point would be. Its shipped
 weights run folded to numpy, so it needs nothing beyond the core; a guide that needs an extra
 is offered only where its requirements can be found (decided without importing them), so an
 install lists only the guides it can run.

@@ -6,7 +6,7 @@ fills, as on slanted walls), unless simplification found no face loop and the tw
 The best program found is rebuilt from its sketches and measured against the target with B-rep
 Booleans, whether or not it is exact, and written out whenever it has a step: a partial program is
 still a start for the user. A result that is not exact carries a ``reason``
-(:mod:`zonegraph.sequence.diagnosis`): the target faces no extrusion can make, whether the zone
+(`zonegraph.sequence.diagnosis`): the target faces no extrusion can make, whether the zone
 graph can hold the target at all, and how each search ended. A search that found no step writes no
 program files (an empty script would look like an answer); its ``reason`` says so first.
 The budget bounds the search alone, each graph's proposal generator set-up included; building the
@@ -88,7 +88,7 @@ class InferResult:
 
     The program is kept as the texts written to ``sequence.py`` and ``sequence.json`` (verified by
     ``script_iou`` and ``json_iou``), so that a result crosses a process boundary as plain data;
-    :meth:`to_part` runs the script. A result of no step has no program: those methods raise.
+    `to_part` runs the script. A result of no step has no program: those methods raise.
 
     Example (a part whose program is exact rebuilds to the target's volume)::
 
@@ -353,17 +353,17 @@ def infer(
         target_path: a STEP, BREP or design JSON file.
         out: output folder (result.json, sequence.py/.json, and when ``render`` steps/ and a PNG).
             The script and JSON carry snapped numbers when they rebuild the part as well as the
-            raw ones (:func:`zonegraph.export.verify.verified_export`).
+            raw ones (`zonegraph.export.verify.verified_export`).
         config: search settings.
         render: write the per-step STEP files and the PNG (the pipeline's bulk runs skip them).
         saved_graph: a folder holding this target's zone graph, reused instead of rebuilt.
 
     Returns:
         The result, also written to ``out/result.json``; when not exact, its ``reason`` says why.
-        A search that found no step writes no program files (its reason says so).
+            A search that found no step writes no program files (its reason says so).
 
     Raises:
-        InputError, ZoneGraphBuildError: as :func:`reconstruct`.
+        InputError, ZoneGraphBuildError: as `reconstruct`.
     """
     path, out_dir = Path(target_path), Path(out)
     rec = reconstruct(path, config, saved_graph)

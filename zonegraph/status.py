@@ -1,9 +1,9 @@
 """The one vocabulary of outcomes: every manifest row, stage record, CLI message and ``result.json``.
 
 A status is a plain string on disk (Parquet, JSON), so that tables stay readable without this
-package; in code it is a member of :class:`Status`, so that a misspelt status fails at import
+package; in code it is a member of `Status`, so that a misspelt status fails at import
 instead of silently counting as a failure. This module imports nothing and serves every layer,
-:mod:`zonegraph.errors` included (each error class names its status).
+`zonegraph.errors` included (each error class names its status).
 """
 
 from __future__ import annotations

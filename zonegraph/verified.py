@@ -2,16 +2,16 @@
 ``generate`` and ``replay`` stages and the tests share.
 
 A design file's ``properties`` (volume, area, body and face counts) are what replaying the file
-measures, and a replay is verified when it reproduces them within :data:`REPLAY_RTOL` (relative
+measures, and a replay is verified when it reproduces them within `REPLAY_RTOL` (relative
 volume and area) with the same number of bodies. For Fusion 360 Gallery's own JSON these are
 Fusion's figures, which our replay reproduces to ~1e-16 on the samples. For a design converted
 from the build123d corpus they are the converter's own replay of the file, measured the same way,
 so every file ``convert`` calls ok replays with exit 0; Fusion's published volume and area are kept
-beside them under :data:`FUSION_FIELD` with their relative differences, because the two part by up
+beside them under `FUSION_FIELD` with their relative differences, because the two part by up
 to ~1e-3 on some designs (build123d's fixed-order integration on spline-bounded faces, Fusion's own
 tolerances), and that is worth knowing rather than hiding. Conversion itself compares our replay
-with the script's part (:data:`REPLAY_RTOL`, re-measured precisely before a mismatch) and with
-Fusion's figures (:data:`FUSION_RTOL`, the ``fusion_mismatch`` status).
+with the script's part (`REPLAY_RTOL`, re-measured precisely before a mismatch) and with
+Fusion's figures (`FUSION_RTOL`, the ``fusion_mismatch`` status).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ def relative_difference(value: float, reference: float) -> float:
 
 @dataclass(frozen=True)
 class Measured:
-    """A replay's figures, as :class:`~zonegraph.data.replay.ReplayResult` measures them (bodies
+    """A replay's figures, as `ReplayResult` measures them (bodies
     summed, as Fusion's ``properties`` are)."""
 
     volume: float
@@ -50,7 +50,7 @@ def file_properties(measured: Measured) -> dict[str, Any]:
 
 
 def fusion_properties(volume: float, area: float, measured: Measured) -> dict[str, float]:
-    """The :data:`FUSION_FIELD` block: Fusion's published figures and how far our replay is."""
+    """The `FUSION_FIELD` block: Fusion's published figures and how far our replay is."""
     return {
         "volume": volume,
         "area": area,

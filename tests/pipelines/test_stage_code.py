@@ -119,7 +119,7 @@ def test_every_code_dep_exists():
 
 
 def test_the_code_deps_cover_every_module_a_stage_imports():
-    """``dvc.yaml``'s code deps are what DVC watches and what :func:`code_fingerprint` hashes into
+    """``dvc.yaml``'s code deps are what DVC watches and what `code_fingerprint` hashes into
     every record: a module a stage imports but does not list would let stale records be reused."""
     for stage, spec in STAGES.items():
         listed = [Path(p) for p in stage_code(stage)]

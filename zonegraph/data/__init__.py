@@ -5,8 +5,8 @@ and written as JSON), ``profiles`` turns sketch curves into faces, ``replay`` ru
 with Fusion's Boolean semantics, ``synthetic`` generates seeded designs in the same format,
 ``dataset`` finds designs and their split, ``stats`` compares a data set with the published
 r1.0.1 figures and ``targets`` reads any supported input (STEP, BREP, design JSON) as solids. The
-replay function is :func:`zonegraph.data.replay.replay` (the module keeps its name). Imports
-only :mod:`zonegraph.geometry` and :mod:`zonegraph.errors`.
+replay function is `zonegraph.data.replay.replay` (the module keeps its name). Imports
+only `zonegraph.geometry` and `zonegraph.errors`.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ per-extrude body/face counts). Everything else in the file (constraints, dimensi
 ``sequence`` block) is ignored on read and left out on write.
 
 Units are the file's: centimetres and radians. Points and vectors are plain ``(x, y, z)`` tuples in
-the sketch's local frame; :class:`Frame` maps them to world coordinates.
+the sketch's local frame; `Frame` maps them to world coordinates.
 """
 
 from __future__ import annotations
@@ -261,7 +261,7 @@ class Design:
 
 
 def load_design(path: str | Path) -> Design:
-    """Read a design file; raises :class:`InputError` or :class:`DesignError` with the reason."""
+    """Read a design file; raises `InputError` or `DesignError` with the reason."""
     path = Path(path)
     require_file(path)
     try:
@@ -272,7 +272,7 @@ def load_design(path: str | Path) -> Design:
 
 
 def parse_design(data: Any, design_id: str, source: str = "") -> Design:
-    """A design from parsed JSON; the schema (:mod:`zonegraph.data.schema`) and every reference
+    """A design from parsed JSON; the schema (`zonegraph.data.schema`) and every reference
     are checked before any geometry is built.
 
     Raises:

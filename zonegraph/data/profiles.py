@@ -148,7 +148,7 @@ def loop_face(loop: Loop, frame: Frame, snap: _Snapper, where: str) -> Face:
 
 
 def face_profile_area(profile: Profile, frame: Frame, where: str) -> float:
-    """The area :func:`profile_faces` builds for the profile of one face (one outer loop, its
+    """The area `profile_faces` builds for the profile of one face (one outer loop, its
     holes inside it and apart), measured loop by loop: the outer loop's face less its holes'.
     ``profile_faces`` cuts the holes out one Boolean at a time, which took minutes on a sketch
     face of a corpus part with hundreds of holes."""

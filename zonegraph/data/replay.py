@@ -41,7 +41,7 @@ class ReplayStep:
     tool: Shape
     bodies: tuple[Solid, ...]
     seconds: float
-    by_cells: bool = False  # the bodies came from the cells of all tools so far (:func:`cells_bodies`)
+    by_cells: bool = False  # the bodies came from the cells of all tools so far (`cells_bodies`)
 
     @property
     def body_count(self) -> int:
@@ -129,7 +129,7 @@ class ReplayResult:
 
     def disagreement(self, tolerance: float = REPLAY_RTOL) -> str | None:
         """How the result differs from the file's own ``properties`` beyond ``tolerance``, or None
-        (what "verified" means: :mod:`zonegraph.verified`)."""
+        (what "verified" means: `zonegraph.verified`)."""
         p = self.design.properties
         if p is None:
             return None
@@ -189,7 +189,7 @@ def _checked_by_cells(design: Design, steps: list[ReplayStep]) -> tuple[ReplaySt
 
 
 def cells_last(steps: Sequence[ReplayStep]) -> tuple[ReplayStep, ...] | None:
-    """``steps`` with the last one's bodies from the cells of all tools (:func:`cells_bodies`), or
+    """``steps`` with the last one's bodies from the cells of all tools (`cells_bodies`), or
     None where the cells cannot give them."""
     cells = cells_bodies(steps)
     if cells is None:
@@ -208,9 +208,9 @@ def replay_extrude(
     """Apply one extrude to ``bodies`` (which are not modified).
 
     ``earlier``: the steps that made ``bodies``, when known; a Boolean that fails or gives an
-    invalid solid is then evaluated on the cells of all their tools (:func:`cells_bodies`), and
+    invalid solid is then evaluated on the cells of all their tools (`cells_bodies`), and
     once a step came from the cells, the next ones do too where they can: a Boolean on such
-    bodies can come back valid yet wrong (as in :func:`zonegraph.sequence.program.execute`)."""
+    bodies can come back valid yet wrong (as in `zonegraph.sequence.program.execute`)."""
     t0 = time.perf_counter()
     try:
         tool = extrude_tool(extrude, sketches, where)
@@ -396,11 +396,11 @@ def apply_operation(bodies: tuple[Solid, ...], tool: Shape, op: Operation) -> tu
     """Fusion's Boolean semantics over separate bodies.
 
     The Booleans take a copy of the tool: build123d's grow their operands' tolerances in place,
-    and the tool goes on into the cells of later steps (:func:`cells_bodies`). A written
+    and the tool goes on into the cells of later steps (`cells_bodies`). A written
     program's join gave an invalid solid, and the cells of its tools, valid when fresh, failed at
     every fuzzy value after the joins had run on them. The bodies are not copied: they are this
     step's own, and a copy changed which common a later IoU could measure. For the same reason
-    the results are cleaned in place, not as :func:`~zonegraph.geometry.occ.unified` does: on
+    the results are cleaned in place, not as `unified` does: on
     copies, the written JSON of 41125_711db4bf_0002 measured 0.9984 instead of exact."""
     tool = _copied(tool)
     tool_solids = tuple(tool.solids())

@@ -12,7 +12,7 @@ Types the replay does not support (an entity or curve ``type`` it does not know,
 extent) are let through by validation, so that building can name them as unsupported features
 rather than as malformed input.
 
-Each model builds its :mod:`zonegraph.data.design` object (``to_domain``), so the file's layout
+Each model builds its `zonegraph.data.design` object (``to_domain``), so the file's layout
 is described once, here: the validated tree converts itself, with no second walk over the dicts.
 """
 
@@ -448,7 +448,7 @@ class DesignFile(Node):
 
 
 def validate_design(data: Any, name: str) -> DesignFile:
-    """Parsed design JSON checked against :class:`DesignFile`.
+    """Parsed design JSON checked against `DesignFile`.
 
     Raises:
         DesignError: naming the first offending field by its path in the file (the entity's uuid

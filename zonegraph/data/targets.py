@@ -1,6 +1,6 @@
 """Load a reconstruction target from a user's file: a STEP/BREP solid or a design JSON.
 
-A STEP or BREP file is read by OCP alone (:func:`load_kernel_target`), so building its zone
+A STEP or BREP file is read by OCP alone (`load_kernel_target`), so building its zone
 graph never imports build123d; a design JSON is replayed, which needs build123d's API.
 """
 
@@ -34,7 +34,7 @@ def load_target(path: str | Path) -> list[Solid]:
 
 
 def load_kernel_target(path: str | Path) -> list[TopoDS_Shape]:
-    """The target solids as OCP shapes (the same solids as :func:`load_target`)."""
+    """The target solids as OCP shapes (the same solids as `load_target`)."""
     path = Path(path)
     if path.suffix.lower() == ".json":
         return [s.wrapped for s in _replayed(path)]
@@ -43,7 +43,7 @@ def load_kernel_target(path: str | Path) -> list[TopoDS_Shape]:
 
 def target_region(solids: list[Solid]) -> Shape:
     """The region a target's solids fill, as one shape: overlapping bodies fused
-    (:func:`~zonegraph.geometry.occ.overlaps_merged`), so that a program that rebuilds the region
+    (`overlaps_merged`), so that a program that rebuilds the region
     measures IoU 1 against it, not against the bodies' volumes summed."""
     from build123d import Shape
 

@@ -6,7 +6,7 @@ profile is;
 ``render`` draws the step strip (green: union, red: subtraction, grey: the shape so far);
 ``snap`` shortens the written numbers and ``verify`` keeps them only where the written files still
 rebuild the part.
-Imports :mod:`zonegraph.sequence`, :mod:`zonegraph.data` and :mod:`zonegraph.geometry`.
+Imports `zonegraph.sequence`, `zonegraph.data` and `zonegraph.geometry`.
 """
 
 from __future__ import annotations

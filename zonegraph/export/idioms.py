@@ -9,7 +9,7 @@ negative distance rather than with a mirrored frame.
 A loop is written as one object (``Circle``, ``Rectangle``, ``SlotCenterToCenter``,
 ``RegularPolygon``) only when the object, built from the numbers as written, has the loop's own
 corners (within the snapping tolerance): recognising is a geometric identity, not a fit. The
-written script is still rebuilt and measured (:mod:`zonegraph.export.verify`), which falls back to
+written script is still rebuilt and measured (`zonegraph.export.verify`), which falls back to
 literal loops when an object's script is not as exact.
 """
 

@@ -7,7 +7,7 @@ tolerance relative to the part (``REL_TOL`` of its bounding-box diagonal: far be
 designer means, far above float noise). A unit vector keeps its components (0.7071067811865476 is
 no noise) except those next to 0 or +-1 (closer than a turn that moves the part by no more than a
 length may move), and is renormalised. Snapping alone proves
-nothing about the part: :mod:`zonegraph.export.verify` rebuilds what is written and falls back to
+nothing about the part: `zonegraph.export.verify` rebuilds what is written and falls back to
 the raw numbers when the snapped ones lose exactness.
 """
 

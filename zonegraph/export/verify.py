@@ -77,7 +77,7 @@ class Export:
 
 # The styles a script is tried in, most idiomatic first; the literal loops are the last resort of
 # build123d's own Booleans, after which the steps are combined by fuzzy Booleans
-# (:func:`fuzzy_styles`).
+# (`fuzzy_styles`).
 STYLES = (IDIOMATIC, ScriptStyle(holes=False), LITERAL)
 
 
@@ -174,7 +174,7 @@ def _pass(
 
 def _design_file(steps: list[WrittenStep], name: str, target: Shape, good: float) -> tuple[str, float, str]:
     """``sequence.json``'s text, its IoU and error: the file carries its own replay's figures as
-    ``properties``, so that replaying it verifies by default (:mod:`zonegraph.verified`). Where
+    ``properties``, so that replaying it verifies by default (`zonegraph.verified`). Where
     that replay falls short of ``good`` and the cells of all its tools come closer, the file
     carries the cells' figures instead, with which its replay takes the last step from them
     (``CELLS_RETRY_RTOL``); that text is replayed again and kept if it measures better."""
@@ -226,7 +226,7 @@ def _file_error(error: str, label: str) -> str:
 
 def _mixed(snapped: Export, raw: Export, floor: float) -> Export:
     """Each file from the pass that rebuilds it better: the snapped text where it fails no worse
-    than the raw one (as :func:`as_good` asks of both), else the raw text. The two files are two
+    than the raw one (as `as_good` asks of both), else the raw text. The two files are two
     rebuilds with their own Booleans, and snapping helps one while it breaks the other (a corpus
     part whose snapped script was exact and raw one 0.03, its snapped JSON 0.03 and raw 0.95)."""
     files = []

@@ -4,7 +4,7 @@ Sketch curves are written in each sketch's own frame (origin: the start plane's 
 input's origin, so a sketch on a principal plane reads in the input's own coordinates; z along the
 extrusion), lines as lines, circular arcs and circles exactly, any other curve as a B-spline (JSON)
 or an interpolating spline through points (script). The script and the JSON are both written from
-one list of :class:`WrittenStep`, whose numbers a :class:`~zonegraph.export.snap.Snapper` chose.
+one list of `WrittenStep`, whose numbers a `Snapper` chose.
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ def step_frame(step: ProgramStep, snap: Snapper | None = None) -> Frame:
     """The sketch frame of a step, with its numbers snapped.
 
     A step along a principal axis is sketched on build123d's named plane of that axis
-    (:data:`~zonegraph.export.idioms.NAMED_PLANES`), whose coordinates are the input's own; its
+    (`NAMED_PLANES`), whose coordinates are the input's own; its
     normal can point against the extrusion (the written distance is then negative). Otherwise x is
     the principal axis least along z, made orthogonal to z; after snapping, x is made orthogonal
     to the snapped z again, so the frame stays orthonormal."""
@@ -126,7 +126,7 @@ def _arc_through(
     """Centre, radius and mid point of the arc from ``start`` to ``end`` (the loop's corners,
     which lie up to the vertex tolerance off the edge's circle) that stays nearest the edge's own
     ``curve`` (points along it, its mid point in the middle): of the circles through both
-    corners, whose centres lie on their bisector, the first among :func:`_bisector_centres` that
+    corners, whose centres lie on their bisector, the first among `_bisector_centres` that
     the curve's points miss by no more than the least miss and what the corners miss the edge's
     own circle by (so a short arc keeps its designer's radius: every circle through its corners
     follows it about as well).
@@ -185,7 +185,7 @@ def _bisector_centres(
 
 
 # Points along an arc (an odd count: the middle one is its mid point) by which a written arc is
-# chosen (:func:`_arc_through`).
+# chosen (`_arc_through`).
 ARC_SAMPLES = 9
 
 
@@ -278,7 +278,7 @@ def _closed_spline(
     Two steps of a corpus part sketch one closed spline, each on a face the partition cut with its
     own seam (25364_b3985755_0002). Sampled from each seam, the two interpolating splines crossed
     each other and their union failed (script IoU 0); sampled from the curve's extreme point along
-    :data:`SEAM_DIRECTION` they are the same points, up to the 8e-6 cm the two faces' curves part."""
+    `SEAM_DIRECTION` they are the same points, up to the 8e-6 cm the two faces' curves part."""
     curve = piece.edge.geom_adaptor()
     direction = SEAM_DIRECTION[0] * np.asarray(frame.x_axis, float) + SEAM_DIRECTION[1] * np.asarray(
         frame.y_axis, float
@@ -448,7 +448,7 @@ class SharedLoops:
 def written_steps(program: list[ProgramStep], snap: Snapper | None = None) -> list[WrittenStep]:
     """The program in sketch coordinates, every number passed through ``snap`` once (and a closed
     free-form loop that an earlier step sketched within what snapping may move written as that
-    loop, :class:`SharedLoops`)."""
+    loop, `SharedLoops`)."""
     snap = snap or Snapper.raw()
     shared = SharedLoops(snap.tol)
     out = []
@@ -490,15 +490,15 @@ def _edge_code(e: LocalEdge) -> str:
 
 @dataclass(frozen=True)
 class ScriptStyle:
-    """Which idioms a script may use. :func:`zonegraph.export.verify.verified_export` drops them
+    """Which idioms a script may use. `zonegraph.export.verify.verified_export` drops them
     (holes first, then objects) where the script they give does not rebuild the part as well."""
 
     objects: bool = True  # loops as Circle, Rectangle, SlotCenterToCenter, RegularPolygon
     holes: bool = True  # a cut of lone circles into a named plane as Hole
-    # not empty: each step's Boolean tries these fuzzy values (input units; :data:`FUZZY_CODE`)
+    # not empty: each step's Boolean tries these fuzzy values (input units; `FUZZY_CODE`)
     fuzzy: tuple[float, ...] = ()
     # with fuzzy values: no Boolean per step; the part is the point set of all the steps' tools,
-    # from one general fuse of them at those values (:data:`POINT_SET_CODE`)
+    # from one general fuse of them at those values (`POINT_SET_CODE`)
     cells: bool = False
 
 
@@ -598,7 +598,7 @@ def _step_code(i: int, step: WrittenStep, unit: str, style: ScriptStyle) -> list
 # no fuzzy value and no check, and on a part whose steps leave faces a hair apart (tolerances grown
 # by earlier Booleans to 1e-5 of the part) they came back valid and wrong: a corpus part's 14th cut
 # left 1.2 of its 15 cm3 in place. The helper does what the program's own rebuild does
-# (:func:`zonegraph.sequence.program.execute`): each Boolean on copies, exact and then at fuzzy
+# (`zonegraph.sequence.program.execute`): each Boolean on copies, exact and then at fuzzy
 # values, the first result valid with a volume its operation allows.
 FUZZY_CODE = """
 def boolean(part, tool, mode):
@@ -636,10 +636,10 @@ def boolean(part, tool, mode):
 # The helper a point-set script defines, the last style tried: a chain of Booleans fails where one
 # link does, and on a corpus part (21638_0a984848_0011) the written tools' sixth cut failed in
 # every chain, at every fuzzy value, while one general fuse of all seven tools gave the part (IoU
-# 0.999998). As :func:`zonegraph.data.replay.cells_bodies` does for a replay: each cell of the
+# 0.999998). As `zonegraph.data.replay.cells_bodies` does for a replay: each cell of the
 # fuse is material when the last tool that holds it adds, i.e. the cells inside an adding tool and
 # outside every later tool. A fuse whose cells change volume when merged is passed over, as in
-# :func:`zonegraph.geometry.cells.select_cells` (a 16-step corpus program's exact fuse merged into
+# `zonegraph.geometry.cells.select_cells` (a 16-step corpus program's exact fuse merged into
 # a "valid" solid of volume -1e-8).
 POINT_SET_CODE = """
 def point_set(steps):
@@ -681,9 +681,9 @@ def point_set(steps):
 def _fuzzy_step_code(
     i: int, step: WrittenStep, plane: str, what: str, mode: str, style: ScriptStyle
 ) -> list[str]:
-    """A step in build123d's algebra mode: the sketch extruded alone, then :data:`FUZZY_CODE`'s
+    """A step in build123d's algebra mode: the sketch extruded alone, then `FUZZY_CODE`'s
     ``boolean`` with the part so far (or, point-set style, the tool kept for
-    :data:`POINT_SET_CODE`)."""
+    `POINT_SET_CODE`)."""
     tool = f"extrude(sketch.sketch, amount={written(step.distance)})"
     combined = f"steps.append(({tool}, {mode}))" if style.cells else f"part = boolean(part, {tool}, {mode})"
     return [
@@ -769,7 +769,7 @@ def written_profile(pid: str, loops: FaceLoops, frame: Frame, face_area: float) 
     neighbouring circle, which the written arc (the loop's corners, the designer's radius) does
     not, so the file was refused although it rebuilt the part. ``face_area`` stands in where the
     written loops do not build, so the replay reports that instead. A sketch face is one outer
-    loop with its holes (:func:`~zonegraph.data.profiles.face_profile_area`)."""
+    loop with its holes (`face_profile_area`)."""
     profile = Profile(pid, tuple(Loop(outer, tuple(e.curve for e in edges)) for outer, edges in loops), None)
     try:
         area = face_profile_area(profile, frame, pid)
@@ -801,7 +801,7 @@ def program_design(steps: list[WrittenStep], name: str) -> Design:
 
 def design_text(steps: list[WrittenStep], name: str, properties: dict | None = None) -> str:
     """``sequence.json``'s text; ``properties``: the final figures its replay is checked against
-    (:mod:`zonegraph.verified`)."""
+    (`zonegraph.verified`)."""
     return json.dumps(design_to_json(program_design(steps, name), properties=properties), indent=1)
 
 

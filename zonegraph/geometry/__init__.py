@@ -1,6 +1,6 @@
 """Geometry helpers over OCP and build123d: B-rep I/O, the normalising transform, zones to solids.
 
-The lowest layer: it imports nothing else from ``zonegraph`` but :mod:`zonegraph.errors`.
+The lowest layer: it imports nothing else from ``zonegraph`` but `zonegraph.errors`.
 ``occ`` holds small typed wrappers over OCP idioms (points, explorers, ancestors, properties).
 """
 

@@ -49,7 +49,7 @@ MERGE_RTOL = 1e-4
 def cells_by_fuzzy(
     arguments: Sequence[TopoDS_Shape], keep: Callable[[frozenset[int]], bool], diag: float
 ) -> Iterator[TopoDS_Shape]:
-    """:func:`select_cells` at each of ``FUZZY_SHARES`` of ``diag`` in turn (a fuse that raises is
+    """`select_cells` at each of ``FUZZY_SHARES`` of ``diag`` in turn (a fuse that raises is
     skipped), for the caller to take the first result it accepts."""
     for share in FUZZY_SHARES:
         try:

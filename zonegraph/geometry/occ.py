@@ -105,7 +105,7 @@ def boolean_of(
     tools: Sequence[TopoDS_Shape],
     fuzzy: float = 0.0,
 ) -> TopoDS_Shape:
-    """``a`` (op) every one of ``tools`` in one Boolean, on copies, as :func:`fuzzy_boolean`.
+    """``a`` (op) every one of ``tools`` in one Boolean, on copies, as `fuzzy_boolean`.
 
     Raises:
         ValueError: the Boolean reported errors.
@@ -337,7 +337,7 @@ def gaps_closed(face: TopoDS_Shape) -> TopoDS_Shape:
     return healed.Face()
 
 
-# The precision to which :func:`gaps_closed` makes curves meet: OpenCASCADE's confusion.
+# The precision to which `gaps_closed` makes curves meet: OpenCASCADE's confusion.
 GAP_PRECISION = 1e-7
 
 

@@ -4,9 +4,9 @@ STEP files are written with a centimetre unit declaration (Fusion 360 Gallery's 
 convert them correctly; OpenCASCADE reads every STEP file back in millimetres. BREP files are the
 lossless native format used between pipeline stages (no unit: the design's centimetres).
 
-Files are read with OCP's own readers (:func:`read_kernel_shape`, :func:`read_kernel_solids`):
+Files are read with OCP's own readers (`read_kernel_shape`, `read_kernel_solids`):
 building a zone graph needs nothing more, and importing build123d would double a short command's
-start-up time and memory. :func:`read_shape` and :func:`read_solids` wrap the same shapes as
+start-up time and memory. `read_shape` and `read_solids` wrap the same shapes as
 build123d objects for the paths that use its API (replay, programs, the exported script).
 """
 
@@ -85,14 +85,14 @@ def read_kernel_solids(path: str | Path) -> list[TopoDS_Shape]:
 
 
 def read_shape(path: str | Path) -> Shape:
-    """A STEP or BREP file as one build123d shape (:func:`read_kernel_shape`)."""
+    """A STEP or BREP file as one build123d shape (`read_kernel_shape`)."""
     from build123d import Compound
 
     return Compound.cast(read_kernel_shape(path))
 
 
 def read_solids(path: str | Path) -> list[Solid]:
-    """The solids of a file as build123d solids (:func:`read_kernel_solids`)."""
+    """The solids of a file as build123d solids (`read_kernel_solids`)."""
     from build123d import Solid
 
     return [Solid(s) for s in read_kernel_solids(path)]
@@ -123,7 +123,7 @@ def symmetric_difference_volume(a: Shape, b: Shape) -> float:
     return volume_of(a.cut(b)) + volume_of(b.cut(a))
 
 
-# Relative slack of :func:`possible_volume`'s bounds, for volume integration error: a failed
+# Relative slack of `possible_volume`'s bounds, for volume integration error: a failed
 # Boolean that the checker accepts loses far more (a valid union of a corpus part that held 1%).
 POSSIBLE_RTOL = 1e-5
 
@@ -140,6 +140,6 @@ def possible_volume(union: bool, part: float, tool: float, result: float) -> boo
 
 def volume_of(shape: Shape | list[Shape] | None) -> float:
     """Volume of a Boolean result: a shape, a list of shapes (build123d's intersect) or None,
-    integrated to 1e-9 (:func:`~zonegraph.geometry.occ.precise_volume`)."""
+    integrated to 1e-9 (`precise_volume`)."""
     shapes = [] if shape is None else shape if isinstance(shape, list) else [shape]
     return sum(precise_volume(s.wrapped) for s in shapes)

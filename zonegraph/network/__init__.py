@@ -2,12 +2,12 @@
 the ranker and the shipped checkpoint (paper sec. 4.2).
 
 Layout: everything a user of ``--guide net`` needs lives here, inside the one installed
-package. The shipped weights run folded to numpy (:mod:`zonegraph.network.folded`), so the core
+package. The shipped weights run folded to numpy (`zonegraph.network.folded`), so the core
 install runs the guide; ``pip install 'zonegraph[train]'`` adds PyTorch checkpoints. The
 training loop, the loss, the label dataset and the model card writer stay in the checkout's
 ``training/`` folder, run with ``python -m`` like the pipeline's stages. This is the one layer
 that imports torch and torch_geometric (``folded`` and ``ranker`` do not); nothing outside it
-imports it eagerly (:mod:`zonegraph.plugins` names the ranker by reference), and this
+imports it eagerly (`zonegraph.plugins` names the ranker by reference), and this
 ``__init__`` imports its names on first use, so ``import zonegraph.network`` alone loads no
 torch either.
 """

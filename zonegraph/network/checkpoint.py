@@ -3,7 +3,7 @@
 A checkpoint holds the model's configuration beside its weights (``training.train`` writes them,
 with the training configuration, metrics and provenance its model card reads), so loading needs
 nothing but the file. The shipped checkpoint is package data, beside its numpy fold
-(:func:`fold_checkpoint`, ``scorer.npz``) which ``--guide net`` loads, so the guide works
+(`fold_checkpoint`, ``scorer.npz``) which ``--guide net`` loads, so the guide works
 without a checkout and without torch.
 """
 
@@ -49,7 +49,7 @@ def guide_settings(checkpoint: dict[str, Any]) -> tuple[int | None, dict[str, An
 
 
 def fold_checkpoint(checkpoint: dict[str, Any]) -> FoldedScorer:
-    """A late-fusion checkpoint's scorer as numpy arrays, with its :func:`guide_settings` and the
+    """A late-fusion checkpoint's scorer as numpy arrays, with its `guide_settings` and the
     projects it trained on."""
     samples, search = guide_settings(checkpoint)
     projects = tuple(checkpoint.get("provenance", {}).get("train_projects", ()))
@@ -59,7 +59,7 @@ def fold_checkpoint(checkpoint: dict[str, Any]) -> FoldedScorer:
 
 
 def fold(model: ProposalScorer) -> FoldedScorer:
-    """The model in eval mode as numpy arrays (:mod:`zonegraph.network.folded`): every BatchNorm
+    """The model in eval mode as numpy arrays (`zonegraph.network.folded`): every BatchNorm
     folded into the Linear or 1x1 convolution beside it. Late fusion only."""
     if model.config.fusion != "late":
         raise ValueError(f"only late fusion folds to numpy (this model: {model.config.fusion})")

@@ -5,7 +5,7 @@ proposal, each zone with its four flags (in target, in canvas, in extrusion, ope
 PyG's batching stacks proposals and states alike; ``proposal`` maps zones to proposals and
 ``zone_of`` to rows of ``points`` (the design's zones, stored once per state, with
 ``zone_edge_index`` between them). Per proposal it carries its features (``feat``, (P, F): every
-column of :data:`zonegraph.sequence.features.FEATURES`; a model reads those its configuration
+column of `zonegraph.sequence.features.FEATURES`; a model reads those its configuration
 names) and ``state``, the state it belongs to once batched (a listwise loss normalises over a
 state's proposals). The search encodes the graph it is searching; the training
 labels (``training.data``) encode the saved graphs the same way.

@@ -4,13 +4,13 @@ In search the network scores a handful of proposals of a small graph at every st
 times per second; there PyG's batching and PyTorch's per-operation dispatch cost more than the
 arithmetic (about 4 ms a state with the heuristic's top 8, against the heuristic's 0.3 ms), and
 importing torch costs a command-line call seconds. In eval mode the network is a chain of affine
-maps and LeakyReLUs, so :func:`zonegraph.network.checkpoint.fold` folds every BatchNorm into the
+maps and LeakyReLUs, so `zonegraph.network.checkpoint.fold` folds every BatchNorm into the
 Linear (or 1x1 convolution) beside it and writes the weights as a ``.npz``; this module evaluates
 that chain with numpy and scipy's sparse mean over zone neighbours, and imports no torch.
 
 It covers late fusion (the default and the shipped checkpoint), with or without the point
 encoder, with or without proposal features; early and factored fusion stay on the PyTorch path.
-The forward is the one of :class:`zonegraph.network.model.ProposalScorer` operation for
+The forward is the one of `zonegraph.network.model.ProposalScorer` operation for
 operation (tests compare both on real graphs).
 """
 
@@ -62,12 +62,12 @@ def run(chain: Chain, x: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class FoldedScorer:
-    """A late-fusion :class:`~zonegraph.network.model.ProposalScorer` in eval mode, as arrays.
+    """A late-fusion `ProposalScorer` in eval mode, as arrays.
 
     ``points``/``head`` encode a zone's samples (absent without the point encoder), ``zone_in``
     reads its code and four flags, each of ``rounds`` reads a zone's code beside its neighbours'
     mean, ``features`` embeds the proposal features (the model's ``columns`` of
-    :data:`zonegraph.sequence.features.FEATURES`), ``readout`` gives the two logits.
+    `zonegraph.sequence.features.FEATURES`), ``readout`` gives the two logits.
     """
 
     config: dict[str, Any]
@@ -114,7 +114,7 @@ class FoldedScorer:
 
         Shapes:
             zones: (P, Z) bool, the extrusions; ops: (P,) +1 union, -1 subtract; geometry: (Z, H)
-            from :meth:`encode_geometry`; features: (P, F) every column of FEATURES; returns (P,).
+            from `encode_geometry`; features: (P, F) every column of FEATURES; returns (P,).
         """
         p, z = zones.shape
         masks = self._computed(state, zones.astype(bool))
@@ -180,7 +180,7 @@ class FoldedScorer:
 
     @classmethod
     def load(cls, path: str | Path) -> FoldedScorer:
-        """The scorer :meth:`save` wrote."""
+        """The scorer `save` wrote."""
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
             chains = {

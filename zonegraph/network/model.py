@@ -17,7 +17,7 @@ Three ways to bring the flags in, all selectable:
   (outside the extrusion, in a union's, in a subtraction's), computed once per state, and a
   proposal is a masked max over them: scoring costs element-wise work per proposal, no matmul.
 
-Proposal features (``ModelConfig.features``, names from :mod:`zonegraph.sequence.features`: the
+Proposal features (``ModelConfig.features``, names from `zonegraph.sequence.features`: the
 heuristic's terms, the extrusion's geometry, the step) join after the pool: standardised by a
 BatchNorm, embedded by a small MLP and concatenated to the pooled zone code before the readout,
 in every fusion. An empty tuple is the paper's network (and every checkpoint trained before).
@@ -111,7 +111,7 @@ class ZoneMessages(MessagePassing):
 
 
 class ProposalScorer(nn.Module):
-    """Two logits per proposal (negative, positive); :meth:`score` gives P(positive).
+    """Two logits per proposal (negative, positive); `score` gives P(positive).
 
     Reads a PyG batch of states (``zonegraph.network.encoding.StateData``): ``x`` (N, 4) flags of the N zone
     copies (one copy of a state's zones per proposal), ``edge_index`` between them, ``proposal``

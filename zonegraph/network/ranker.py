@@ -1,11 +1,11 @@
 """The network guide: a trained scorer behind the search's ``Ranker`` protocol.
 
-:mod:`zonegraph.plugins` names it as the ``net`` guide by reference, so ``zonegraph infer PART
+`zonegraph.plugins` names it as the ``net`` guide by reference, so ``zonegraph infer PART
 --guide net`` and ``make_ranker("net")`` import this module only when the guide is used. A
 late-fusion scorer (the default, and the shipped one) runs folded to numpy
-(:mod:`zonegraph.network.folded`): the shipped ``scorer.npz`` needs no torch at all, and a
+(`zonegraph.network.folded`): the shipped ``scorer.npz`` needs no torch at all, and a
 PyTorch checkpoint of late fusion is folded when loaded. Early and factored fusion, or a
-``device`` other than the CPU, keep the PyTorch forward (:mod:`zonegraph.network.scoring`).
+``device`` other than the CPU, keep the PyTorch forward (`zonegraph.network.scoring`).
 Either way a graph's zone geometry is encoded once and each state's proposals are scored in one
 batched pass, in eval mode.
 
@@ -60,7 +60,7 @@ class StateScorer(Protocol):
 
 
 class NumpyScorer:
-    """A :class:`FoldedScorer` with its graph's adjacency and geometry codes kept between states.
+    """A `FoldedScorer` with its graph's adjacency and geometry codes kept between states.
 
     OpenBLAS would spread each small product over every core, and with the other core busy (two
     pipeline workers on two cores) its threads wait on each other: a 40-zone state took 94 ms

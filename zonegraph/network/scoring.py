@@ -46,7 +46,7 @@ def score_state(
 
     Shapes:
         canvas: (Z,) bool; zones: (P, Z) bool; ops: (P,) +1 union, -1 subtract; features: (P, F)
-        (:mod:`zonegraph.sequence.features`; zeros when not given); returns (P,).
+        (`zonegraph.sequence.features`; zeros when not given); returns (P,).
     """
     if model.training:  # eval() walks every module: 10% of a search's scoring when called per state
         model.eval()
@@ -61,7 +61,7 @@ def score_state(
 
 
 class TorchScorer:
-    """A checkpoint's :class:`ProposalScorer` behind the ranker's ``StateScorer`` protocol, for
+    """A checkpoint's `ProposalScorer` behind the ranker's ``StateScorer`` protocol, for
     what does not fold to numpy (early and factored fusion) or runs on another device."""
 
     def __init__(self, checkpoint: dict[str, Any], device: str = "cpu") -> None:

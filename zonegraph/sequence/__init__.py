@@ -1,9 +1,9 @@
 """Sequence search (paper sec. 4): extrusion proposals, rankers, best-first search, programs.
 
 ``proposals`` holds every proposal rule, ``rankers`` the random and heuristic guides and the
-:class:`Ranker` protocol a learned guide satisfies, ``best_first`` the top-k search with
+`Ranker` protocol a learned guide satisfies, ``best_first`` the top-k search with
 backtracking, and ``program`` turns a found sequence into real sketches and extrusions rebuilt
-with build123d. Imports :mod:`zonegraph.zones` and :mod:`zonegraph.geometry`.
+with build123d. Imports `zonegraph.zones` and `zonegraph.geometry`.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ the top k are kept (k may shrink with depth, as the paper's 15 - 0.5 per level),
 explored first, and a dead end (no proposal, depth limit, a canvas seen before) backs up to the
 next of the top k. The search stops when the canvas equals the target or a budget (wall clock,
 expansions) is spent, and returns the best canvas seen: highest zone IoU, then fewest steps. The
-wall clock is a :class:`Deadline` that proposal generation checks too, since one expansion of a
+wall clock is a `Deadline` that proposal generation checks too, since one expansion of a
 graph of thousands of zones can outlast the whole budget. The anytime trace of (seconds, best IoU)
 feeds IoU-vs-time curves.
 """
@@ -38,7 +38,7 @@ class SearchConfig(Config):
         max_expansions: a work bound (states expanded); unlike seconds it is the same on any
             machine, so seeded runs bounded by it are reproducible.
 
-    ``zonegraph infer`` derives it from its :class:`~zonegraph.configs.InferConfig` (which holds
+    ``zonegraph infer`` derives it from its `InferConfig` (which holds
     every field of it) with ``SearchConfig.from_mapping(asdict(infer_config))``.
     """
 
@@ -108,7 +108,7 @@ def search(
 
     Args:
         graph: the zone graph; its ``zone_inside`` is the target.
-        ranker: scores all proposals of a state at once (see :class:`Ranker`).
+        ranker: scores all proposals of a state at once (see `Ranker`).
         config: width, depth and budget.
         generator: a proposal generator to reuse (its memoised sweeps carry over); by default a
             new level-1 generator.
@@ -118,7 +118,7 @@ def search(
 
     Returns:
         The best canvas seen (highest zone IoU, then fewest steps), exact or not, with the anytime
-        trace and per-expansion statistics.
+            trace and per-expansion statistics.
     """
     if deadline is None:
         deadline = Deadline.after(config.budget_s)

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 @dataclass
 class Deadline:
     """A point on ``clock`` past which bounded work stops; ``checks`` counts the calls of
-    :meth:`passed` (how often the work looked), ``expired_checks`` those that found it passed."""
+    `passed` (how often the work looked), ``expired_checks`` those that found it passed."""
 
     at: float = math.inf
     clock: Callable[[], float] = field(default=time.perf_counter, repr=False)

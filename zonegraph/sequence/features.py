@@ -4,7 +4,7 @@ A learned guide that sees only zone flags must rediscover what the hand-made heu
 how far a step brings the canvas towards the target. These features give it the heuristic's own
 terms and the proposal's geometry, computed from the zone graph alone (no OpenCASCADE), so the
 ``labels`` stage stores them in its Parquet shards and the search computes the same numbers for
-the network at every state (:func:`proposal_features` is the one definition of both).
+the network at every state (`proposal_features` is the one definition of both).
 
 Scales are the normalised frame's (the target's box has unit diagonal), so they do not depend on
 the part's size; counts are kept raw (the network standardises its inputs).
@@ -73,7 +73,7 @@ def proposal_features(
     Args:
         canvas: (Z,) bool, the state's canvas.
         step: operations applied before this state.
-        on_target: :func:`target_surfaces` of ``graph``, when the caller keeps it per graph.
+        on_target: `target_surfaces` of ``graph``, when the caller keeps it per graph.
     """
     if not proposals:
         return np.zeros((0, len(FEATURES)), np.float32)

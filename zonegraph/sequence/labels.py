@@ -13,7 +13,7 @@ split of one step into two count. p = the share of completions that reach the ta
 with p = 0 are negative; if none has p = 0, the one with the smallest p (the first in proposal
 order on ties) is negative; the rest are neutral.
 
-Every proposal row also carries its :mod:`zonegraph.sequence.features` (columns ``feat_<name>``),
+Every proposal row also carries its `zonegraph.sequence.features` (columns ``feat_<name>``),
 the numbers the network guide reads beside the zone flags, computed by the same function the
 search calls, so training and search see one definition.
 
@@ -176,8 +176,8 @@ def label_design(
         slack: completion length beyond the remaining GT steps.
 
     Returns:
-        One :class:`LabelledStep` per GT step; steps whose GT is not captured carry a reason and
-        no proposals.
+        One `LabelledStep` per GT step; steps whose GT is not captured carry a reason and
+            no proposals.
     """
     completer = Completer(graph, ProposalGenerator(graph, level=level), design_rng(seed, design_id))
     canvas = np.zeros(graph.n_zones, bool)
@@ -248,8 +248,8 @@ def _ids(mask: np.ndarray) -> list[int]:
 def label_tables(
     steps: Sequence[LabelledStep], gt: Sequence[GTOperation], design_id: str, split: str
 ) -> tuple[pa.Table, pa.Table]:
-    """The labels of one design as the ``(proposals, steps)`` tables of :data:`PROPOSAL_SCHEMA`
-    and :data:`STEP_SCHEMA`: plain Parquet columns, readable without this package."""
+    """The labels of one design as the ``(proposals, steps)`` tables of `PROPOSAL_SCHEMA`
+    and `STEP_SCHEMA`: plain Parquet columns, readable without this package."""
     n = len(gt)
     proposals = [
         {

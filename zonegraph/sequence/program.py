@@ -104,8 +104,8 @@ def _prism(face: Face, d: Vector) -> Solid:
 
 def _swept_true(prism: Solid, face: Face, d: Vector) -> Solid:
     """``prism``, or where its volume misses the face's area times the depth by more than
-    :data:`PRISM_RTOL`, the prism of the face with its curves' gaps closed
-    (:func:`~zonegraph.geometry.occ.gaps_closed`) when that one is valid and sound. A prism
+    `PRISM_RTOL`, the prism of the face with its curves' gaps closed
+    (`gaps_closed`) when that one is valid and sound. A prism
     missing 1.1e-4 of its volume left a zone-exact corpus program 1.3e-5 short of the target
     (21638_0a984848_0011; its written files, whose corners are shared, were not)."""
     off = _unsound(prism, face, d)
@@ -124,7 +124,7 @@ def _swept_true(prism: Solid, face: Face, d: Vector) -> Solid:
 
 
 def _unsound(prism: Solid, face: Face, d: Vector) -> float:
-    """How far a prism's volume (integrated to 1e-9 by :func:`volume_of`) misses its face's area
+    """How far a prism's volume (integrated to 1e-9 by `volume_of`) misses its face's area
     times its depth, relative to the latter; 1 for a prism or face of no positive size (turned
     inside out). The area is integrated to 1e-9 too where the default integration, cheap but
     ~1e-4 off on spline-bounded faces, says the prism misses: read by it, a corpus spline
@@ -158,7 +158,7 @@ def partition_faces(graph: ZoneGraph) -> list:
 
 def merge_faces(faces: list) -> list[Face]:
     """Coplanar faces sharing edges merged into as few clean faces as possible, without the
-    internal wires a merge can leave (:func:`~zonegraph.geometry.occ.without_internal_wires`)."""
+    internal wires a merge can leave (`without_internal_wires`)."""
     shapes = [Shape.cast(f) for f in faces]
     merged = shapes[0].fuse(*shapes[1:]) if len(shapes) > 1 else shapes[0]
     return [Face(without_internal_wires(f.wrapped)) for f in _unified(merged).faces()]
@@ -203,7 +203,7 @@ class RebuildError(RuntimeError):
 
 @contextmanager
 def kernel_guard(what: str) -> Iterator[None]:
-    """Turns OpenCASCADE's exceptions within into a :class:`RebuildError` naming ``what`` failed,
+    """Turns OpenCASCADE's exceptions within into a `RebuildError` naming ``what`` failed,
     so ``infer`` reports a ``rebuild_failed`` part with the reason instead of failing; anything
     else is a bug of ours and keeps its traceback."""
     try:
@@ -219,8 +219,8 @@ def execute(program: list[ProgramStep]) -> list[Shape | None]:
 
     An invalid Boolean result (a union of two prisms sharing a cylindrical wall, on the corpus)
     makes every later Boolean, and the final IoU, come back empty or wrong: each step keeps the
-    first valid result of the alternatives in :func:`_combine`, else of one general fuse of every
-    tool so far (:func:`_cells_rebuild`), else the first result it has. Once a step came from the
+    first valid result of the alternatives in `_combine`, else of one general fuse of every
+    tool so far (`_cells_rebuild`), else the first result it has. Once a step came from the
     cells, later steps do too where they can: a Boolean run on such a part (fuzzy, loose
     tolerances) can come back valid yet with a vertex tolerance of a few percent of the part,
     after which no common with the target holds more than a sliver of it (the measured case:
@@ -295,7 +295,7 @@ def _step(shape: Shape, tools: list[Shape], ops: list[Op], by_cells: bool) -> tu
 def _combine(shape: Shape, tool: Shape, op: Op) -> tuple[Shape | None, bool]:
     """``shape`` fused with or cut by ``tool``, trying in turn: the operands as they are, the tool
     repaired, fuzzy values, and the part so far repaired; with whether the result is accepted.
-    The first result the checker accepts with a volume the operation allows (:func:`_possible`)
+    The first result the checker accepts with a volume the operation allows (`_possible`)
     wins, else the first result as it came: an invalid part often still takes the next Booleans,
     while repairing one in place can break the next union (``docs/results/evidence.md``). None
     when every Boolean failed."""
@@ -367,12 +367,12 @@ def _boolean(shape: Shape, tool: Shape, op: Op, fuzzy: float) -> Shape | None:
 
 
 def _cleaned(shape: Shape) -> Shape:
-    """``shape`` with its same-domain faces merged (:func:`~zonegraph.geometry.occ.unified`, on a
+    """``shape`` with its same-domain faces merged (`unified`, on a
     copy, so the raw shape stays as it was), unless the merge breaks a valid shape: seen on a
     corpus part whose valid union of two prisms came back invalid from it, so every alternative
     and the cells failed with it and a program exact on zones was reported ``rebuild_failed``.
     The merged faces are cosmetic. Stray open shells are dropped
-    (:func:`~zonegraph.geometry.occ.without_open_shells`)."""
+    (`without_open_shells`)."""
     cleaned = _unified(shape)
     chosen = cleaned if cleaned.is_valid or not shape.is_valid else shape
     return Shape.cast(without_open_shells(chosen.wrapped))
@@ -391,7 +391,7 @@ ALIKE_RTOL = 1e-4
 
 
 def brep_iou(a: Shape | None, b: Shape, fuzzy: float = 0.0) -> float:
-    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans, volumes by :func:`volume_of`.
+    """vol(a and b) / vol(a or b) with OpenCASCADE Booleans, volumes by `volume_of`.
 
     A Boolean common of two coincident solids can come back empty although both are valid, and
     which call fails depends on the argument order (on the corpus: common(program, target) empty,
@@ -424,8 +424,8 @@ def _common_operands(a: Shape, b: Shape, fuzzy: float, alike: bool) -> Iterator[
     """Both orders at ``fuzzy``, then (when that is not 0) both exact, then with a fuzzy value of
     1e-9 of the part (a valid program whose exact commons with the target were all empty took
     it), then a repaired part, and, for solids of the same volume (``alike``), the part with its
-    tolerances limited (:func:`_tightened`); each common takes fresh copies
-    (:func:`_common_volume`). A fuzzy value helps faces a hair apart and can itself lose the
+    tolerances limited (`_tightened`); each common takes fresh copies
+    (`_common_volume`). A fuzzy value helps faces a hair apart and can itself lose the
     volume (a written file of a corpus part whose commons at every fuzzy value from 1e-9 to 1e-4
     of the part held 4% of it, and its exact common all of it). Lazy: the usual first common is
     whole, and nothing after it is computed."""

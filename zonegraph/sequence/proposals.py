@@ -68,7 +68,7 @@ class Proposal:
     """One candidate operation: extrude ``faces`` on plane ``start`` to plane ``end``.
 
     Two proposals are equal (and hash alike) when they do the same thing to any canvas: the same
-    extrusion volume with the same operation, whichever sketch produced it (:attr:`key`).
+    extrusion volume with the same operation, whichever sketch produced it (`key`).
 
     Shapes:
         zones: (Z,) bool over the zone graph's zones.
@@ -366,7 +366,7 @@ class ProposalGenerator:
 
     def _crossings(self, d: np.ndarray, length: float) -> tuple[list[bool], list[bool]]:
         """For every face, whether a sweep along d (of ``length``) goes on through it out of its
-        first zone, and out of its second (kept per plane pair by :meth:`_slab`): a planar face
+        first zone, and out of its second (kept per plane pair by `_slab`): a planar face
         when it faces along d (a cap); a curved face unless it lies on a cylinder or extrusion
         along d (a side wall); never a face inside one zone (the sweep is on both of its sides
         already). Classifying all faces at once replaced a per-face test that was half a sweep's

@@ -94,10 +94,10 @@ def score_step(
 
 def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
     """The ranker a guide name stands for: ``heuristic``, ``random`` (seeded), or one that
-    :mod:`zonegraph.plugins` loads by reference.
+    `zonegraph.plugins` loads by reference.
 
     Those are called with ``model`` and ``seed``: the network guide ``net``
-    (:class:`zonegraph.network.ranker.NetworkRanker`, with the train extra) and the entry points
+    (`zonegraph.network.ranker.NetworkRanker`, with the train extra) and the entry points
     of installed packages in the ``zonegraph.rankers`` group. This is how they reach the search
     without this layer importing torch.
 
@@ -120,9 +120,9 @@ class GTPlace:
     """Where the GT landed among a state's P proposals: ``above`` others scored higher, ``ties``
     scored the same (ties are broken uniformly at random, so they count half in the rank).
 
-    Three scales of one rank: :attr:`relative` is the paper's rank / P (1/P at best, about
-    (P + 1) / 2P for random scores, so it depends on P), :attr:`normalised` is (rank - 1) / (P - 1)
-    (0 at best, 0.5 for random scores at any P; undefined for one proposal), :attr:`floor` is the
+    Three scales of one rank: `relative` is the paper's rank / P (1/P at best, about
+    (P + 1) / 2P for random scores, so it depends on P), `normalised` is (rank - 1) / (P - 1)
+    (0 at best, 0.5 for random scores at any P; undefined for one proposal), `floor` is the
     best possible rank / P of the state.
     """
 

@@ -2,20 +2,20 @@
 
 What the tests and the benchmarks share, defined once:
 
-- :mod:`zonegraph.testing.locations`: where the real samples and the corpus are
-  (``SAMPLES``, ``CORPUS``, :func:`sample_paths`), looked for beside the checkout;
+- `zonegraph.testing.locations`: where the real samples and the corpus are
+  (``SAMPLES``, ``CORPUS``, `sample_paths`), looked for beside the checkout;
 - ``requires_samples`` / ``requires_corpus``: pytest skip markers, from
-  :mod:`zonegraph.testing.markers`, loaded on first use: pytest is in the ``test`` extra, and this
+  `zonegraph.testing.markers`, loaded on first use: pytest is in the ``test`` extra, and this
   package must stay importable without it (the benchmarks read the locations);
-- :func:`gt_rows`: the ground-truth stage's rows of in-memory ``GTStep`` objects;
-- :mod:`zonegraph.testing.fuzz`: the fuzz harness (mutated real inputs through the CLI, each run
+- `gt_rows`: the ground-truth stage's rows of in-memory ``GTStep`` objects;
+- `zonegraph.testing.fuzz`: the fuzz harness (mutated real inputs through the CLI, each run
   classified), shared by ``bench/fuzz_bench.py`` and the fuzz tests (needs hypothesis);
-- :mod:`zonegraph.testing.corpus` (real corpus designs replayed),
-  :mod:`zonegraph.testing.fusion_json` (hand-written design JSON),
-  :mod:`zonegraph.testing.mlflow_server` (a real tracking server) and
-  :mod:`zonegraph.testing.stages` (a pipeline stage in a fresh interpreter).
+- `zonegraph.testing.corpus` (real corpus designs replayed),
+  `zonegraph.testing.fusion_json` (hand-written design JSON),
+  `zonegraph.testing.mlflow_server` (a real tracking server) and
+  `zonegraph.testing.stages` (a pipeline stage in a fresh interpreter).
 
-Nothing below :mod:`zonegraph.testing` imports it: it is a top layer.
+Nothing below `zonegraph.testing` imports it: it is a top layer.
 """
 
 from __future__ import annotations

@@ -438,7 +438,7 @@ CONVERT_MEMORY_MB = 1024  # a model that allocates without bound stops here (out
 
 @cache
 def script_texts() -> dict[str, bytes]:
-    """One batch file per :data:`CORPUS_MODELS` design: the batch's imports, the model's function
+    """One batch file per `CORPUS_MODELS` design: the batch's imports, the model's function
     and its ``MODELS`` entry (Fusion's volume and area); empty without the corpus."""
     batch = CORPUS / "01_2ops" / "batch_001.py"
     if not batch.is_file():
@@ -555,7 +555,7 @@ def seed_only() -> Iterator[None]:
 def draw_cases(count: int, seed_value: int, strategy: st.SearchStrategy[Case]) -> list[Case]:
     """``count`` distinct cases, the same for the same seed: Hypothesis's generate phase only
     (no database, no shrinking), derandomized, seeded and blind to the project's source
-    (:func:`seed_only`)."""
+    (`seed_only`)."""
     found: dict[str, Case] = {}
 
     @seed(seed_value)

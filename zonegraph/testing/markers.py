@@ -1,6 +1,6 @@
 """Skip markers for tests that need the real data: the only module here that imports pytest.
 
-pytest is in the ``test`` extra, not the core install, so :mod:`zonegraph.testing` loads this
+pytest is in the ``test`` extra, not the core install, so `zonegraph.testing` loads this
 module only when a marker is first asked for; ``import zonegraph`` never imports pytest.
 """
 

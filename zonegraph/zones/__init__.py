@@ -1,9 +1,9 @@
 """Zone graphs (paper sec. 3): extend the target's faces, partition its box, label and link zones.
 
 ``extension`` and ``face_loops`` choose the extended surfaces, ``build`` runs the general fuse and
-checks the invariants, ``model`` holds the resulting arrays (:class:`ZoneGraph`), ``sampling``
+checks the invariants, ``model`` holds the resulting arrays (`ZoneGraph`), ``sampling``
 draws the zones' surface samples and ``storage`` saves and loads a graph as Parquet + BREP.
-Imports only :mod:`zonegraph.geometry`, :mod:`zonegraph.errors` and :mod:`zonegraph.status`.
+Imports only `zonegraph.geometry`, `zonegraph.errors` and `zonegraph.status`.
 """
 
 from __future__ import annotations

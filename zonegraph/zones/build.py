@@ -392,7 +392,7 @@ class _Region:
     """The region the target's solids fill, and its volume by the default integration; to 1e-9
     when asked (a few milliseconds a solid, paid only on a graph that fails a check).
 
-    Overlapping bodies are fused for it (:func:`overlaps_merged`): their volumes summed count the
+    Overlapping bodies are fused for it (`overlaps_merged`): their volumes summed count the
     overlap twice. Their faces and classifiers stay the bodies' own (a fused pair classified zones
     outside it as inside on a corpus part)."""
 
@@ -413,7 +413,7 @@ def _volumes_off(graph: ZoneGraph) -> tuple[bool, bool]:
 
 
 def _precise_where_off(graph: ZoneGraph, zones: list, region: _Region) -> None:
-    """Zone and target volumes integrated to 1e-9 (:func:`precise_volume`) where the default
+    """Zone and target volumes integrated to 1e-9 (`precise_volume`) where the default
     integration, ~1e-4 accurate on surfaces of extrusion and B-splines, breaks the box or the
     target check: a corpus graph whose zones summed to 1.000066 of the box that way sums to it
     within 5e-7 integrated precisely (9 of the whole corpus's refusals build with it). Only then:

@@ -126,7 +126,7 @@ def load_zone_graph(folder: str | Path, solids: bool = True) -> ZoneGraph:
     """Read a saved graph back, equal to the one saved.
 
     Args:
-        folder: written by :func:`save_zone_graph`.
+        folder: written by `save_zone_graph`.
         solids: also read the zone solids (``zones.brep``); skip them for array-only work.
 
     Raises:
@@ -151,7 +151,7 @@ def _one_line(exc: BaseException) -> str:
 
 
 def _inconsistency(graph: ZoneGraph) -> str | None:
-    """What in a read graph cannot come from :func:`save_zone_graph`, or None: non-finite or
+    """What in a read graph cannot come from `save_zone_graph`, or None: non-finite or
     negative measures (normals and offsets are NaN off planes), indices out of range, a zone
     solid per zone missing."""
     measures = {  # always finite

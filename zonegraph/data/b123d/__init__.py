@@ -3,15 +3,15 @@
 The corpus (``../shared/data/fusion360_b123d``) holds each design as a function ``model_<id>()``
 whose body replays Fusion's sketch + extrude timeline with build123d. One module per step:
 
-- :mod:`.listing`: the designs and Fusion's figures, found without running any code;
-- :mod:`.comments`: where each Fusion feature starts in the source, and its operation;
-- :mod:`.shims` and :mod:`.loading`: importing a batch written for build123d 0.10;
-- :mod:`.recording`: the ``extrude`` calls a model makes, with the faces they sweep;
-- :mod:`.curves`: each face as sketch-local loops of exact profile curves;
-- :mod:`.features`: the calls as our typed timeline, one extrude per Fusion feature;
-- :mod:`.verify`: our replay against the script's own part;
-- :mod:`.convert`: one design through all of it (in a killable child:
-  :func:`zonegraph.jobs.convert_isolated`).
+- `.listing`: the designs and Fusion's figures, found without running any code;
+- `.comments`: where each Fusion feature starts in the source, and its operation;
+- `.shims` and `.loading`: importing a batch written for build123d 0.10;
+- `.recording`: the ``extrude`` calls a model makes, with the faces they sweep;
+- `.curves`: each face as sketch-local loops of exact profile curves;
+- `.features`: the calls as our typed timeline, one extrude per Fusion feature;
+- `.verify`: our replay against the script's own part;
+- `.convert`: one design through all of it (in a killable child:
+  `zonegraph.jobs.convert_isolated`).
 
 The package keeps the ``b123d`` name of the data source (``params.yaml``'s ``data.source: b123d``)
 and of the module it replaces, so that every ``zonegraph.data.b123d`` import still holds.

@@ -1,12 +1,12 @@
 """One corpus design converted: its script run, its extrudes turned into our JSON, verified.
 
-We *run* ``model_<id>()`` with ``extrude`` replaced by a recorder (:mod:`.recording`), turn each
-recorded face back into profile curves (:mod:`.curves`) and each Fusion feature into one extrude
-(:mod:`.features`), replay the JSON and compare it with the script's own part and Fusion's figures
-(:mod:`.verify`, :mod:`zonegraph.verified`). Nothing a design does can escape as an exception:
-every failure of the design becomes a :class:`ConvertedDesign` with a status and a one-line reason;
+We *run* ``model_<id>()`` with ``extrude`` replaced by a recorder (`.recording`), turn each
+recorded face back into profile curves (`.curves`) and each Fusion feature into one extrude
+(`.features`), replay the JSON and compare it with the script's own part and Fusion's figures
+(`.verify`, `zonegraph.verified`). Nothing a design does can escape as an exception:
+every failure of the design becomes a `ConvertedDesign` with a status and a one-line reason;
 a failure of our own code raises (its traceback is kept). A design's endless or crashing C call
-is stopped by running it in a killable child (:func:`zonegraph.jobs.convert_isolated`).
+is stopped by running it in a killable child (`zonegraph.jobs.convert_isolated`).
 """
 
 from __future__ import annotations
@@ -77,7 +77,7 @@ def convert_design(
     """Run ``model_<design_id>`` of a batch, convert its extrudes to our JSON and verify the replay.
 
     Fusion's volume/area default to the batch's ``MODELS`` entry. Never raises for a bad design;
-    runs in this process with no time limit (see :func:`zonegraph.jobs.convert_isolated`).
+    runs in this process with no time limit (see `zonegraph.jobs.convert_isolated`).
     """
     t0 = time.perf_counter()
     path = Path(batch_path)

@@ -28,7 +28,7 @@ class NotAProfile(ValueError):
 
 
 def slit_profile_faces(edges: list[Any]) -> list[Any]:
-    """The faces the closed loops of ``edges`` bound (bridges dropped), or :class:`NotAProfile`.
+    """The faces the closed loops of ``edges`` bound (bridges dropped), or `NotAProfile`.
 
     Each loop inside no other is an outer boundary and the loops directly inside it its holes
     (two holes joined by a slit are two holes); an island inside a hole is not a profile.
@@ -77,7 +77,7 @@ def _point(v: Any) -> np.ndarray:
 
 
 def _vertex_ids(points: list[np.ndarray]) -> list[int]:
-    """Each point's vertex number; points within :data:`VERTEX_TOL` share one."""
+    """Each point's vertex number; points within `VERTEX_TOL` share one."""
     reps: list[np.ndarray] = []
     out = []
     for p in points:

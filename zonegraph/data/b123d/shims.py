@@ -1,7 +1,7 @@
 """Bridges between the scripts' build123d/OCP and ours: the scripts target build123d 0.10.
 
 ``EllipticalCenterArc``'s old positional form is mapped onto the 0.13 signature, ``make_face`` on
-the curves of a slit profile builds the region Fusion meant (:mod:`.faces`), and the OCP 8 array
+the curves of a slit profile builds the region Fusion meant (`.faces`), and the OCP 8 array
 classes are aliased under their old names.
 """
 
@@ -99,7 +99,7 @@ def _install_make_face_shim(module: types.ModuleType) -> None:
 
 
 def _slit_make_face(edges: Any, mode: Any, refusal: ValueError) -> Any:
-    """build123d's ``make_face`` steps with :func:`slit_profile_faces` as the face (the refusal
+    """build123d's ``make_face`` steps with `slit_profile_faces` as the face (the refusal
     re-raised where the edges are not a slit profile either)."""
     from build123d import BuildSketch, Compound, Curve, ShapeList, Sketch, Wire
     from build123d.build_common import flatten_sequence

@@ -5,8 +5,8 @@ build123d's Mode.ADD fuses everything into one part, while Fusion's NewBody keep
 Cut and Intersect all distribute over the union, so the union of a correct replay is the script's
 point set exactly, while the body-summed volume double counts overlapping NewBody bodies.
 build123d's ``volume``/``area`` integrate with a fixed Gauss order that is off by up to ~1e-4 on
-faces trimmed by B-spline curves, so a replay that misses :data:`REPLAY_RTOL` is re-measured
-precisely (:mod:`zonegraph.geometry.occ`) and, failing that, by its symmetric difference with the
+faces trimmed by B-spline curves, so a replay that misses `REPLAY_RTOL` is re-measured
+precisely (`zonegraph.geometry.occ`) and, failing that, by its symmetric difference with the
 script's part before it is a mismatch.
 """
 
