@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 import os
 import signal
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -12,7 +14,7 @@ from distributed import Client
 
 from pipelines import zonegraphs
 from pipelines.records import MAX_ATTEMPTS, RECORD_VERSION
-from pipelines.runner import Job, records_frame, run_jobs
+from pipelines.runner import PROJECT, Job, records_frame, run_jobs
 from zonegraph.errors import InputError
 from zonegraph.isolation import run_isolated
 
@@ -161,3 +163,32 @@ def test_a_memory_hog_is_out_of_memory():
 
 def _allocate(mb: int):
     return len(bytearray(mb << 20))
+
+
+def _imports_build123d_on_first_use(path: str) -> dict:
+    """A job that, like the ground truth's shape readers, imports build123d only when it runs."""
+    import build123d  # noqa: F401
+
+    return {}
+
+
+def test_workers_import_the_shape_library_once_not_each_design(tmp_path):
+    """A design's child is forked from the worker: what the job imports on first use is already
+    there when the worker imported it before (`warm_worker`), so the child pays nothing for it."""
+    script = (
+        "import sys\n"
+        "from pathlib import Path\n"
+        "from distributed import Client\n"
+        "from pipelines.runner import Job, run_jobs\n"
+        "from tests.pipelines.test_runner import _imports_build123d_on_first_use as job\n"
+        "with Client(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as c:\n"
+        f"    run_jobs(job, [Job('a', 'f', ('a',))], Path({str(tmp_path)!r}), c, 60, 't')\n"
+        "    print(c.run(lambda: 'build123d' in sys.modules).popitem()[1])\n"
+    )
+    env = {**os.environ, "DASK_DISTRIBUTED__WORKER__DAEMON": "False"}
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, env=env, cwd=PROJECT, timeout=300
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "True"
+    assert json.loads((tmp_path / "a.json").read_text())["status"] == "ok"
