@@ -11,6 +11,7 @@ from build123d import Box, Cylinder, Pos
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.jobs import label_and_save
+from zonegraph.sequence import labels, proposals
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.labels import (
     NEGATIVE,
@@ -167,3 +168,19 @@ def test_proposal_features_are_the_heuristic_terms_and_the_geometry_the_search_s
     assert (first[:, column["missing"]] == 1).all() and (second[:, column["missing"]] == 0).all()
     table, _ = label_tables(steps, ops, "part", "train")
     assert [f"feat_{n}" for n in FEATURES] == table.column_names[-len(FEATURES) :]
+
+
+@requires_samples
+def test_labels_do_not_depend_on_what_the_memos_keep(samples_dir, monkeypatch):
+    """The generator's and the completions' memos only save work: with room for one entry each
+    (every other group, component, sweep and canvas computed again) the labels are the same."""
+    r = replay(load_design(samples_dir / "Couch.json"))
+    graph = build_zone_graph(list(r.bodies), samples=0)
+    operations = [s["operation"] for s in r.summary()["steps"]]
+    gt = ground_truth(graph, [s.tool.wrapped for s in r.steps], operations)
+    ops = [GTOperation(s.zones, s.op, s.captured[1], s.operation, s.reason) for s in gt.steps]
+    kept = label_tables(label_design(graph, ops, "couch"), ops, "couch", "train")[0]
+    monkeypatch.setattr(proposals, "MEMO_BYTES", dict.fromkeys(proposals.MEMO_BYTES, 0))
+    monkeypatch.setattr(labels, "CANVAS_MEMO_BYTES", 0)
+    forgotten = label_tables(label_design(graph, ops, "couch"), ops, "couch", "train")[0]
+    assert kept.num_rows > 10 and kept.equals(forgotten)

@@ -18,7 +18,8 @@ the numbers the network guide reads beside the zone flags, computed by the same 
 search calls, so training and search see one definition.
 
 Costs are shared across all completions of a design: the generator's memoised sweeps and a
-canvas -> proposals cache (canvases as packed bit vectors). Everything random comes from one
+canvas -> proposals cache (canvases as packed bit vectors), each bounded, the least recently used
+dropped first (`zonegraph.sequence.memo`). Everything random comes from one
 generator seeded by (seed, design id): the same seed gives the same labels.
 """
 
@@ -33,11 +34,13 @@ import numpy as np
 import pyarrow as pa
 
 from zonegraph.sequence.features import FEATURES, proposal_features, target_surfaces
+from zonegraph.sequence.memo import Memo
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
 
 POSITIVE, NEUTRAL, NEGATIVE = 1, 0, -1
 DEFAULT_SLACK = 2
+CANVAS_MEMO_BYTES = 128 * 2**20  # the canvases' proposal lists kept (references, not proposals)
 
 _IDS = pa.list_(pa.int32())
 PROPOSAL_SCHEMA = pa.schema(
@@ -118,7 +121,7 @@ class Completer:
         self.target_key = np.packbits(self.target).tobytes()
         self.generator = generator
         self.rng = rng
-        self._cache: dict[bytes, list[Proposal]] = {}
+        self._cache: Memo[list[Proposal]] = Memo(CANVAS_MEMO_BYTES, lambda props: 100 + 8 * len(props))
         self.expansions = 0
 
     def proposals(self, canvas: np.ndarray, banned: set[tuple[bytes, int]]) -> list[Proposal]:

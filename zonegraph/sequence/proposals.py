@@ -38,12 +38,19 @@ from functools import cached_property
 import numpy as np
 
 from zonegraph.sequence.deadline import Deadline
+from zonegraph.sequence.memo import Memo
 from zonegraph.zones.model import ZoneGraph
 
 PARALLEL_TOL = 1e-9
 MIN_DISTANCE = 1e-5  # normalised units: closer parallel planes are not an extrusion
 PRISM_RTOL = 1e-4
 SIDE_WALL_KINDS = ("cylinder", "extrusion")  # curved surfaces a sweep along their axis runs beside
+# What the memos of one generator keep (bytes), the least recently used dropped first: the face
+# groups' candidates, their components, and the components' sweeps.
+MEMO_BYTES = {"groups": 256 * 2**20, "components": 32 * 2**20, "sweeps": 128 * 2**20}
+
+
+_Swept = tuple[np.ndarray, set[int]]  # a component's swept zones (Z,) bool, the faces its sweeps need
 
 
 @dataclass(frozen=True)
@@ -142,6 +149,12 @@ class _Candidates:
     union: tuple[Proposal, ...]
     subtract: tuple[Proposal, ...]
 
+    @property
+    def nbytes(self) -> int:
+        """About what keeping it costs: the volumes twice (the matrix, each proposal's row) and
+        the proposal objects."""
+        return 2 * self.volumes.nbytes + 600 * len(self.union) + 200
+
     @cached_property
     def rows(self) -> tuple[np.ndarray, tuple[Proposal, ...]]:
         """Each volume as a union then a subtraction: (2K, bytes) packed keys and the proposals."""
@@ -179,14 +192,22 @@ class ProposalGenerator:
         self.pairs = self._plane_pairs(planes)
         self.faces_on = {int(s): np.flatnonzero(graph.face_surface == s) for s in planes}
         self._links_on = self._links_by_plane(planes)
+        self._local_links = self._local_links_by_plane()
         self._zone_faces = self._faces_of_zones()
         self._sweeps: dict[tuple[int, int, int], Sweep | None] = {}
         self._face_zone_list = [tuple(pair) for pair in graph.face_zones.tolist()]
         self._face_surface_list = graph.face_surface.tolist()
         self._zone_face_lists = [faces.tolist() for faces in self._zone_faces]
         self._side_lists: dict[int, list[int]] = {}
-        self._groups: dict[tuple[int, int, bytes], _Candidates] = {}
+        self._groups: Memo[_Candidates] = Memo(MEMO_BYTES["groups"], lambda c: c.nbytes)
+        self._comps: Memo[list[list[int]]] = Memo(
+            MEMO_BYTES["components"], lambda comps: 100 + sum(60 + 8 * len(c) for c in comps)
+        )
+        self._swept_comps: Memo[_Swept | None] = Memo(
+            MEMO_BYTES["sweeps"], lambda swept: 100 if swept is None else 200 + swept[0].nbytes
+        )
         self._reach: dict[tuple[int, int], _Reach] = {}
+        self._all_reach: _Reach | None = None
         self._slabs: dict[tuple[int, int], _Slab] = {}
         self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
         self._flatten_pairs()
@@ -218,6 +239,19 @@ class ProposalGenerator:
             plane = int(self.graph.face_surface[a])
             if plane in out:
                 out[plane].append((a, b))
+        return out
+
+    def _local_links_by_plane(self) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+        """Each plane's face links as positions in ``faces_on[plane]``: a face group's links are
+        then one mask away, where walking every link of the plane per group was the largest cost
+        of an expansion on graphs of hundreds of zones."""
+        out = {}
+        for s, links in self._links_on.items():
+            faces = self.faces_on[s]
+            ends = np.array(links, np.int64).reshape(-1, 2)
+            pos = np.minimum(np.searchsorted(faces, ends), max(len(faces) - 1, 0))
+            on_plane = (faces[pos] == ends).all(axis=1) if len(faces) else np.zeros(len(ends), bool)
+            out[s] = (pos[on_plane, 0], pos[on_plane, 1])
         return out
 
     def _flatten_pairs(self) -> None:
@@ -386,37 +420,74 @@ class ProposalGenerator:
 
     def sketches(self, faces: np.ndarray, s: int) -> list[tuple[int, ...]]:
         """Candidate sketches from one group of faces on plane s (components, their unions)."""
-        if not len(faces):
+        comps = self._components(np.isin(self.faces_on[s], faces), s)
+        return [tuple(sorted(f for c in combo for f in comps[c])) for combo in self._combos(len(comps))]
+
+    def _combos(self, n: int) -> list[tuple[int, ...]]:
+        """The components a sketch takes, of n: any 1..level of them or all but 0..level, by size."""
+        if not n:
             return []
-        comps = self._components(faces, s)
-        n = len(comps)
         sizes = set(range(1, min(self.level, n) + 1)) | set(range(max(n - self.level, 1), n + 1))
-        out = []
-        for size in sorted(sizes):
-            for combo in itertools.combinations(range(n), size):
-                out.append(tuple(sorted(f for c in combo for f in comps[c])))
-        return out
+        return [combo for size in sorted(sizes) for combo in itertools.combinations(range(n), size)]
 
-    def _components(self, faces: np.ndarray, s: int) -> list[list[int]]:
-        """Edge-connected components of ``faces`` on plane s, each sorted, ordered by first face.
+    def _components(self, mask: np.ndarray, s: int) -> list[list[int]]:
+        """Edge-connected components of the faces ``mask`` selects of plane s's faces, each
+        sorted, ordered by first face.
 
-        A union-find over the plane's own links: this runs for every group of every state, and
-        building a sparse matrix per call cost more than the rest of an expansion."""
-        parent = {int(f): int(f) for f in faces}
+        A union-find over the group's own links (found with one mask over the plane's): this runs
+        for every new group of every state, and building a sparse matrix per call cost more than
+        the rest of an expansion."""
+        la, lb = self._local_links[s]
+        keep = mask[la] & mask[lb]
+        members = np.flatnonzero(mask).tolist()
+        parent = {i: i for i in members}
 
-        def root(f: int) -> int:
-            while parent[f] != f:
-                parent[f] = parent[parent[f]]
-                f = parent[f]
-            return f
+        def root(i: int) -> int:
+            while parent[i] != i:
+                parent[i] = parent[parent[i]]
+                i = parent[i]
+            return i
 
-        for a, b in self._links_on[s]:
-            if a in parent and b in parent:
-                parent[root(a)] = root(b)
+        for a, b in zip(la[keep].tolist(), lb[keep].tolist(), strict=True):
+            parent[root(a)] = root(b)
         comps: dict[int, list[int]] = {}
-        for f in parent:
-            comps.setdefault(root(f), []).append(f)
-        return sorted(sorted(c) for c in comps.values())
+        for i in members:  # ascending: each component's faces come out sorted
+            comps.setdefault(root(i), []).append(i)
+        faces = self.faces_on[s]
+        return sorted(faces[c].tolist() for c in comps.values())
+
+    def _components_memo(self, mask: np.ndarray, s: int) -> list[list[int]]:
+        """`_components`, kept per (plane, group) while recent: a group on s recurs with every
+        plane parallel to s as its end."""
+        key = (s, mask.tobytes())
+        comps = self._comps.get(key)
+        if comps is None:
+            comps = self._comps[key] = self._components(mask, s)
+        return comps
+
+    def _component_sweep(self, faces: list[int], s: int, e: int) -> _Swept | None:
+        """The zones a component's faces sweep from s to e and the faces on s its shared sweeps
+        stand on, or None when a face's prism is not filled: what `extrusion` finds for any
+        sketch holding the component, computed once for all of them (and kept while recent: one
+        component recurs in the groups of many canvases)."""
+        key = (s, e, tuple(faces))
+        if key in self._swept_comps:
+            return self._swept_comps[key]
+        swept = self._swept_comps[key] = self._sweep_faces(faces, s, e)
+        return swept
+
+    def _sweep_faces(self, faces: list[int], s: int, e: int) -> _Swept | None:
+        """`_component_sweep` made: the faces' sweeps joined."""
+        volume = np.zeros(self.graph.n_zones, bool)
+        needs: set[int] = set()
+        for f in faces:
+            swept = self.sweep(f, s, e)
+            if swept is None:
+                return None
+            if len(swept.faces) > 1:
+                needs.update(swept.faces)
+            volume |= swept.zones
+        return volume, needs
 
     def extrusion(self, faces: tuple[int, ...], s: int, e: int) -> np.ndarray | None:
         """The zones of the sketch ``faces`` extruded from s to e, or None when a face's prism is
@@ -445,19 +516,32 @@ class ProposalGenerator:
         completions: generating them once per group is what makes an expansion cheap."""
         key = (s, e, mask.tobytes())
         hit = self._groups.get(key)
-        if hit is None:
-            volumes, union, subtract = [], [], []
-            for sketch in self.sketches(self.faces_on[s][mask], s):
-                if deadline is not None and deadline.passed():
-                    return None
-                volume = self.extrusion(sketch, s, e)
-                if volume is None or not volume.any():
-                    continue
-                volumes.append(volume)
-                union.append(Proposal(s, e, sketch, volume, Op.UNION))
-                subtract.append(Proposal(s, e, sketch, volume, Op.SUBTRACT))
-            matrix = np.array(volumes, bool).reshape(len(volumes), self.graph.n_zones)
-            hit = self._groups[key] = _Candidates(matrix, tuple(union), tuple(subtract))
+        if hit is not None:
+            return hit
+        comps = self._components_memo(mask, s)
+        parts: list[_Swept | None] = []
+        for comp in comps:
+            if deadline is not None and deadline.passed():
+                return None
+            parts.append(self._component_sweep(comp, s, e))
+        volumes, union, subtract = [], [], []
+        for combo in self._combos(len(comps)):
+            swept = [part for part in (parts[c] for c in combo) if part is not None]
+            if len(swept) < len(combo):
+                continue  # a face's prism is not filled
+            sketch = tuple(sorted(f for c in combo for f in comps[c]))
+            needed = set().union(*(needs for _, needs in swept))
+            if needed and not needed.issubset(sketch):
+                continue  # a shared sweep stands on faces outside the sketch
+            volume = swept[0][0] if len(swept) == 1 else np.logical_or.reduce([v for v, _ in swept])
+            if not volume.any():
+                continue
+            volumes.append(volume)
+            union.append(Proposal(s, e, sketch, volume, Op.UNION))
+            subtract.append(Proposal(s, e, sketch, volume, Op.SUBTRACT))
+        matrix = np.array(volumes, bool).reshape(len(volumes), self.graph.n_zones)
+        hit = _Candidates(matrix, tuple(union), tuple(subtract))
+        self._groups[key] = hit
         return hit
 
     def proposals(self, canvas: np.ndarray, deadline: Deadline | None = None) -> list[Proposal]:
@@ -479,7 +563,7 @@ class ProposalGenerator:
         found: list[_Candidates] = []
         masks = [
             (i, [mask[self._starts[i] : self._ends[i]] for g, mask in enumerate(groups) if filled[g][i]])
-            for i in range(len(self.pairs))
+            for i in np.flatnonzero(filled[0] | filled[1] | filled[2]).tolist()
         ]
         if not self._extend(found, masks, deadline):
             return self._distinct(found, canvas) if found else []
@@ -487,16 +571,62 @@ class ProposalGenerator:
         # expansion, and a deadline that passes during them leaves the proposals of groups 1-3.
         nothing = np.zeros_like(canvas)
         needs = ((canvas & ~self.target, canvas & self.target), (self.target & ~canvas, nothing))
-        for i, (s, e) in enumerate(self.pairs):
-            reach = self._reach_of(s, e, deadline)
-            if reach is None:
-                break
-            cut, join = reach.meets(*needs[0]), reach.meets(*needs[1])
-            extra = [cut] if cut.any() else []
-            extra += [join | groups[1][self._starts[i] : self._ends[i]]] if join.any() else []
+        every = self._every_reach()
+        if every is None:
+            self._reach_pair_by_pair(found, groups[1], needs, deadline)
+            return self._distinct(found, canvas) if found else []
+        cuts, joins = every.meets(*needs[0]), every.meets(*needs[1])
+        cut_any, join_any = self._any_per_pair(cuts), self._any_per_pair(joins)
+        for i in np.flatnonzero(cut_any | join_any).tolist():
+            span = slice(self._starts[i], self._ends[i])
+            extra = [cuts[span]] if cut_any[i] else []
+            extra += [joins[span] | groups[1][span]] if join_any[i] else []
             if not self._extend(found, [(i, extra)], deadline):
                 break
         return self._distinct(found, canvas) if found else []
+
+    def _reach_pair_by_pair(
+        self,
+        found: list[_Candidates],
+        joined: np.ndarray,
+        needs: tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]],
+        deadline: Deadline | None,
+    ) -> None:
+        """Groups 4 and 5 while some pair's sweeps are still to be made (a graph's first
+        expansions): each pair's reach made, under ``deadline``, as the pair's turn comes."""
+        for i, (s, e) in enumerate(self.pairs):
+            reach = self._reach_of(s, e, deadline)
+            if reach is None:
+                return
+            cut, join = reach.meets(*needs[0]), reach.meets(*needs[1])
+            extra = [cut] if cut.any() else []
+            extra += [join | joined[self._starts[i] : self._ends[i]]] if join.any() else []
+            if not self._extend(found, [(i, extra)], deadline):
+                return
+
+    def _every_reach(self) -> _Reach | None:
+        """Every pair's reach in one, its faces laid out as the pairs' flattened faces, once all
+        are made (else None): testing a canvas on all pairs at once, where a test per pair was a
+        fifth of an expansion's time on graphs of hundreds of zones."""
+        if self._all_reach is None and len(self._reach) == len(self.pairs):
+            empty = _Reach(np.zeros(0, bool), np.zeros(0, np.int32), np.zeros(0, np.int64))
+            reaches = [empty] + [self._reach[pair] for pair in self.pairs]
+            offsets = np.cumsum([len(r.zones) for r in reaches])  # where each pair's zones begin
+            starts = [empty.starts] + [r.starts + o for r, o in zip(reaches[1:], offsets, strict=False)]
+            self._all_reach = _Reach(
+                np.concatenate([r.ok for r in reaches]),
+                np.concatenate([r.zones for r in reaches]),
+                np.concatenate(starts),
+            )
+        return self._all_reach
+
+    def _any_per_pair(self, flags: np.ndarray) -> np.ndarray:
+        """(pairs,) bool: whether any of a pair's faces is set in ``flags`` (the flattened faces)."""
+        out = np.zeros(len(self.pairs), bool)
+        filled = self._ends > self._starts
+        if filled.any():
+            out[filled] = np.logical_or.reduceat(flags, self._starts[filled])
+        return out
 
     def _extend(
         self, found: list[_Candidates], masks: list[tuple[int, list[np.ndarray]]], deadline: Deadline | None
