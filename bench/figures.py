@@ -346,6 +346,24 @@ def rank_figure(results: dict) -> dict:
     return {"guides": guides, "vs_heuristic": ratios}
 
 
+HEAVY_FIELDS = ("folder", "zones", "build_s", "expansion_s", "first_proposals", "ground_truth_s", "labels_s")
+
+
+def heavy_figure(rows: list[dict]) -> dict:
+    """The heavy-part benchmark by design: zones, each stage's CPU seconds (absent where the
+    design ran out of time first), its status and its whole time."""
+    return {
+        "designs": {
+            r["design_id"]: {
+                **{k: r[k] for k in HEAVY_FIELDS if k in r},
+                "status": r["status"],
+                "seconds": r["seconds"],
+            }
+            for r in rows
+        }
+    }
+
+
 FIGURES_OF = {
     "build": build_figure,
     "search": search_figure,
@@ -358,6 +376,7 @@ FIGURES_OF = {
     "verify": verify_figure,
     "guide-cost": guide_cost_figure,
     "rank": rank_figure,
+    "heavy": heavy_figure,
 }
 
 

@@ -362,6 +362,33 @@ def rank(records: list[dict]) -> str:
     return text + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+HEAVY_COLUMNS = (("zones", 0), ("build_s", 1), ("expansion_s", 2), ("first_proposals", 0), ("labels_s", 1))
+
+
+def heavy(records: list[dict]) -> str:
+    """The heaviest parts, one figure per checkout (oldest first): zones and each stage's CPU
+    seconds as ``before → after``; a stage the design did not reach in its time says so."""
+
+    def cell(d: dict | None, key: str, digits: int = 1) -> str:
+        if d is None:
+            return "-"
+        if key in d:
+            return f"{d[key]:,.{digits}f}" if isinstance(d[key], float) else f"{d[key]:,}"
+        return f"> {d['seconds']:,.0f} ({d['status']})" if d["status"] != "ok" else "-"
+
+    designs = list(dict.fromkeys(name for r in records for name in r["figure"]["designs"]))
+    lines = [
+        "| design | folder | zones | build CPU s | first expansion CPU s | first proposals | labels CPU s |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name in designs:
+        runs = [r["figure"]["designs"].get(name) for r in records]
+        folder = next(d["folder"] for d in runs if d is not None)
+        cells = [" → ".join(cell(d, key, digits) for d in runs) for key, digits in HEAVY_COLUMNS]
+        lines.append(_row(f"{name}", [folder, *cells]))
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
 RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "build": build,
     "search": search,
@@ -376,6 +403,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "guide-cost": guide_cost,
     "report": report,
     "rank": rank,
+    "heavy": heavy,
 }
 
 

@@ -16,6 +16,7 @@ from bench.figures import (
     fault_figure,
     fuzz_figure,
     guide_cost_figure,
+    heavy_figure,
     rank_figure,
     report_figure,
 )
@@ -292,3 +293,20 @@ def test_the_rank_figure_keeps_every_scale_with_its_interval_and_the_ratio():
         in table
     )
     assert "| run | net | 0.549 | 0.473 - 0.625 |" in table
+
+
+def test_the_heavy_figure_shows_each_stage_before_and_after_and_what_ran_out_of_time():
+    """Two checkouts' runs of bench.heavy_bench side by side; a stage the design never reached
+    (it timed out during the labels) reads as more than its whole time, not as a number."""
+    base = {"design_id": "d1", "folder": "08_21plus", "zones": 627, "build_s": 13.7, "expansion_s": 0.27}
+    before = [base | {"first_proposals": 280, "labels_s": 169.1, "status": "ok", "seconds": 190.0}]
+    after = [base | {"build_s": 15.0, "first_proposals": 579, "status": "timeout", "seconds": 1800.0}]
+    records = [
+        {"name": n, "command": "python -m bench.heavy_bench", "commit": c, "measured": "2026-12-06"}
+        | {"figure": heavy_figure(rows)}
+        for n, c, rows in (("heavy-before", "9491b5a", before), ("heavy-after", "5fcbc01", after))
+    ]
+    assert records[1]["figure"]["designs"]["d1"]["status"] == "timeout"
+    table = _hook().heavy(records)
+    row = next(line for line in table.splitlines() if line.startswith("| d1 |"))
+    assert "13.7 → 15.0" in row and "280 → 579" in row and "169.1 → > 1,800 (timeout)" in row
