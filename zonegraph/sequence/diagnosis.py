@@ -208,7 +208,7 @@ def uncovered_zones(generator: ProposalGenerator, deadline: Deadline) -> np.ndar
                 return None
             swept = generator.sweep(face, s, e)
             if swept is not None:
-                covered |= swept.zones
+                covered[swept.members] = True
     return np.flatnonzero(g.zone_inside.astype(bool) & ~covered)
 
 

@@ -40,7 +40,9 @@ from zonegraph.zones.model import ZoneGraph
 
 POSITIVE, NEUTRAL, NEGATIVE = 1, 0, -1
 DEFAULT_SLACK = 2
-CANVAS_MEMO_BYTES = 128 * 2**20  # the canvases' proposal lists kept (references, not proposals)
+# The canvases' proposal lists kept: each counted with the zones of the proposals it holds (shared
+# ones counted again), since a kept list keeps them alive after the generator drops them.
+CANVAS_MEMO_BYTES = 256 * 2**20
 
 _IDS = pa.list_(pa.int32())
 PROPOSAL_SCHEMA = pa.schema(
@@ -121,7 +123,8 @@ class Completer:
         self.target_key = np.packbits(self.target).tobytes()
         self.generator = generator
         self.rng = rng
-        self._cache: Memo[list[Proposal]] = Memo(CANVAS_MEMO_BYTES, lambda props: 100 + 8 * len(props))
+        held = 8 + graph.n_zones  # a reference and the proposal's zones
+        self._cache: Memo[list[Proposal]] = Memo(CANVAS_MEMO_BYTES, lambda props: 100 + held * len(props))
         self.expansions = 0
 
     def proposals(self, canvas: np.ndarray, banned: set[tuple[bytes, int]]) -> list[Proposal]:
