@@ -10,12 +10,27 @@ from typing import Any
 
 from zonegraph.testing import CORPUS
 
-__all__ = ["CORPUS", "require_corpus", "run_designs", "write_results"]
+__all__ = ["CORPUS", "replayed", "require_corpus", "run_designs", "write_results"]
 
 
 def require_corpus(path: Path) -> None:
     if not path.is_dir():
         raise SystemExit(f"corpus not found at {path} (clone Fusion360GalleryDataset-build123d there)")
+
+
+def replayed(batch: str, design_id: str, work: str | Path) -> tuple[Any, dict]:
+    """A corpus design converted (in a killable child, as the ``generate`` stage does), written
+    under ``work`` and replayed: the replay and an empty row, or None and the failure's row."""
+    from zonegraph.data.design import load_design
+    from zonegraph.data.replay import replay
+    from zonegraph.jobs import convert_isolated
+
+    converted = convert_isolated(batch, design_id, timeout=120)
+    if not converted.ok or converted.design_json is None:
+        return None, {"status": f"convert_{converted.status}", "reason": converted.reason}
+    path = Path(work) / f"{design_id}.json"
+    path.write_text(json.dumps(converted.design_json))
+    return replay(load_design(path)), {}
 
 
 def run_designs(

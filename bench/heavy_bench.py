@@ -12,7 +12,8 @@ ground truth, then the labeller exactly as the ``labels`` stage runs it. Each st
 (``process_time``: core-seconds, robust to a busy machine) and wall seconds are written as soon as
 the stage ends, so a design that runs out of time still reports the stages it finished. The file
 imports only names that have not moved since the start-up work of issue 27, so the same file
-measures an older checkout (copy it into a worktree there) against this one.
+measures an older checkout (copy it and ``bench/corpus.py`` into a worktree there) against this
+one.
 """
 
 from __future__ import annotations
@@ -27,12 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from bench.corpus import CORPUS, require_corpus, run_designs, write_results
+from bench.corpus import CORPUS, replayed, require_corpus, run_designs, write_results
 from zonegraph.data.b123d import CorpusEntry, list_corpus
-from zonegraph.data.design import load_design
-from zonegraph.data.replay import replay
 from zonegraph.isolation import run_isolated
-from zonegraph.jobs import convert_isolated
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.labels import GTOperation, label_design
 from zonegraph.sequence.proposals import ProposalGenerator
@@ -54,12 +52,9 @@ def _timed(progress: Path, row: dict, stage: str, fn: Callable[[], Any]) -> Any:
 
 def _measure(entry: CorpusEntry, work: str, level: int, seed: int) -> dict:
     progress = Path(work) / f"{entry.design_id}.progress.json"
-    converted = convert_isolated(entry.batch, entry.design_id, timeout=120)
-    if not converted.ok or converted.design_json is None:
-        return {"status": f"convert_{converted.status}", "reason": converted.reason}
-    path = Path(work) / f"{entry.design_id}.json"
-    path.write_text(json.dumps(converted.design_json))
-    r = replay(load_design(path))
+    r, failed = replayed(entry.batch, entry.design_id, work)
+    if r is None:
+        return failed
     row: dict = {"faces_in": sum(len(b.faces()) for b in r.bodies)}
     graph = _timed(progress, row, "build", lambda: build_zone_graph(list(r.bodies), samples=0))
     row["zones"] = graph.n_zones

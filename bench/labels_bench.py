@@ -18,20 +18,16 @@ estimate is a lower bound when any did); writes ``results.json`` and ``results.m
 from __future__ import annotations
 
 import argparse
-import json
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from bench.corpus import CORPUS, require_corpus, run_designs, write_results
+from bench.corpus import CORPUS, replayed, require_corpus, run_designs, write_results
 from zonegraph.data.b123d import CorpusEntry, list_corpus
 from zonegraph.data.dataset import stratified_sample, test_ids
-from zonegraph.data.design import load_design
-from zonegraph.data.replay import replay
 from zonegraph.isolation import run_isolated
-from zonegraph.jobs import convert_isolated
 from zonegraph.sequence.ground_truth import ground_truth
 from zonegraph.sequence.labels import NEGATIVE, NEUTRAL, POSITIVE, GTOperation, label_design
 from zonegraph.status import Status
@@ -50,12 +46,9 @@ def training_sample(corpus: Path, count: int, seed: int) -> list[CorpusEntry]:
 
 def _label(entry: CorpusEntry, work: str, seed: int, level: int, multiplier: float, slack: int) -> dict:
     t0 = time.perf_counter()
-    converted = convert_isolated(entry.batch, entry.design_id, timeout=120)
-    if not converted.ok or converted.design_json is None:
-        return {"status": f"convert_{converted.status}", "reason": converted.reason}
-    path = Path(work) / f"{entry.design_id}.json"
-    path.write_text(json.dumps(converted.design_json))
-    r = replay(load_design(path))
+    r, failed = replayed(entry.batch, entry.design_id, work)
+    if r is None:
+        return failed
     graph = build_zone_graph(list(r.bodies), samples=0)
     operations = [s["operation"] for s in r.summary()["steps"]]
     gt = ground_truth(graph, [s.tool.wrapped for s in r.steps], operations, (level,))
