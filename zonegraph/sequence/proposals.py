@@ -271,6 +271,7 @@ class ProposalGenerator:
         lengths = np.array([len(b) for b in beyond], np.int64)
         self._ends = np.cumsum(lengths)
         self._starts = self._ends - lengths
+        self._faced = lengths > 0  # the pairs with faces on their start plane
         flat = np.concatenate(beyond) if beyond else np.zeros(0, np.int64)
         self._flat_valid = flat >= 0
         self._flat_zone = np.where(self._flat_valid, flat, 0)
@@ -488,7 +489,8 @@ class ProposalGenerator:
         return swept
 
     def _sweep_faces(self, faces: list[int], s: int, e: int) -> _Swept | None:
-        """`_component_sweep` made: the faces' sweeps joined."""
+        """The faces' sweeps joined (the zones, and the faces on s their shared sweeps stand on),
+        or None when a face's prism is not filled: a component's, or a whole sketch's."""
         volume = np.zeros(self.graph.n_zones, bool)
         needs: set[int] = set()
         for f in faces:
@@ -503,18 +505,11 @@ class ProposalGenerator:
     def extrusion(self, faces: tuple[int, ...], s: int, e: int) -> np.ndarray | None:
         """The zones of the sketch ``faces`` extruded from s to e, or None when a face's prism is
         not filled exactly or stands on zones that faces outside the sketch stand on too."""
-        volume = np.zeros(self.graph.n_zones, bool)
-        members: set[int] | None = None
-        for f in faces:
-            swept = self.sweep(f, s, e)
-            if swept is None:
-                return None
-            if len(swept.faces) > 1:
-                members = set(faces) if members is None else members
-                if not members.issuperset(swept.faces):
-                    return None
-            volume[swept.members] = True
-        return volume
+        swept = self._sweep_faces(list(faces), s, e)
+        if swept is None:
+            return None
+        volume, needs = swept
+        return volume if needs.issubset(faces) else None
 
     def _candidates(
         self, s: int, e: int, mask: np.ndarray, deadline: Deadline | None = None
@@ -634,9 +629,8 @@ class ProposalGenerator:
     def _any_per_pair(self, flags: np.ndarray) -> np.ndarray:
         """(pairs,) bool: whether any of a pair's faces is set in ``flags`` (the flattened faces)."""
         out = np.zeros(len(self.pairs), bool)
-        filled = self._ends > self._starts
-        if filled.any():
-            out[filled] = np.logical_or.reduceat(flags, self._starts[filled])
+        if self._faced.any():
+            out[self._faced] = np.logical_or.reduceat(flags, self._starts[self._faced])
         return out
 
     def _extend(
