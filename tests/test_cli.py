@@ -218,6 +218,16 @@ def test_a_model_for_a_guide_that_uses_none_is_refused(samples_dir, tmp_path, ca
     assert not (tmp_path / "o").exists()
 
 
+def test_a_model_that_is_not_a_checkpoint_is_one_line_before_any_work(samples_dir, tmp_path, capsys):
+    target = str(samples_dir / "SingleSketchExtrude.json")
+    junk = tmp_path / "junk.npz"
+    junk.write_text("not a zip")
+    assert main(["infer", target, "--out", str(tmp_path / "o"), "--guide", "net", "--model", str(junk)]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"zonegraph: error: {junk}: not a folded scorer")
+    assert not (tmp_path / "o").exists()
+
+
 def test_a_part_past_its_memory_limit_is_one_out_of_memory_line(samples_dir, tmp_path, capsys):
     out = tmp_path / "out"
     argv = ["build", str(samples_dir / "Couch.step"), "--out", str(out), "--samples", "1000000"]

@@ -176,7 +176,20 @@ def _guide_error(config: InferConfig) -> str | None:
         return f"--model {config.model}: the {config.guide} guide uses no model (only --guide net does)"
     if config.model is not None and not Path(config.model).is_file():
         return f"{config.model}: no such model checkpoint"
+    if config.model is not None and str(config.model).endswith(".npz"):
+        return _folded_problem(Path(config.model))
     return None if config.model is None else model_problem(str(config.model))
+
+
+def _folded_problem(path: Path) -> str | None:
+    """Why a folded checkpoint cannot be read, from its header (its weights are read in search)."""
+    from zonegraph.network.folded import FoldedScorer
+
+    try:
+        FoldedScorer.header(path)
+    except ValueError as e:
+        return str(e)
+    return None
 
 
 def _infer_job(config: InferConfig, timeout: float, memory_mb: int | None) -> BatchJob:

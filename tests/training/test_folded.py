@@ -173,3 +173,33 @@ def test_top_m_and_margin_leave_the_network_only_the_heuristics_best_proposals(s
     assert (within >= 0).sum() == 3
     lone = NetworkRanker(top_m=0, margin=0.0).score_at(graph, canvas, proposals, 0)
     np.testing.assert_array_equal(np.argsort(-lone, kind="stable"), np.argsort(-heuristic, kind="stable"))
+
+
+@requires_samples
+def test_the_shipped_weights_are_read_on_the_first_state_the_network_scores(states):
+    ranker = NetworkRanker()
+    assert not ranker.scorer.loaded and ranker.top_m == FoldedScorer.load(SHIPPED_FOLDED).search["top_m"]
+    graph = states[0][0]  # Couch: the completing cut is taken unscored
+    canvas = np.zeros(graph.n_zones, bool)
+    proposals = ProposalGenerator(graph).proposals(canvas)
+    box = max(proposals, key=lambda p: HeuristicRanker().score(graph, canvas, [p])[0])
+    after = box.apply(canvas)
+    finishing = ProposalGenerator(graph).proposals(after)
+    assert any(np.array_equal(p.apply(after), graph.zone_inside.astype(bool)) for p in finishing)
+    ranker.score_at(graph, after, finishing, 1)
+    assert not ranker.scorer.loaded, "a state with a completing step read the weights"
+    scores = ranker.score_at(graph, canvas, proposals, 0)
+    assert ranker.scorer.loaded
+    np.testing.assert_array_equal(scores, NetworkRanker().score_at(graph, canvas, proposals, 0))
+
+
+def test_a_folded_scorer_missing_its_arrays_is_refused_when_opened(tmp_path):
+    path = tmp_path / "cut.npz"
+    with np.load(SHIPPED_FOLDED) as data:
+        kept = {k: data[k] for k in data.files if not k.startswith("rounds.")}
+    np.savez(path, **kept)
+    with pytest.raises(ValueError, match="cut.npz: a folded scorer without the arrays of rounds"):
+        NetworkRanker(path)
+    (tmp_path / "text.npz").write_text("not a zip")
+    with pytest.raises(ValueError, match="text.npz: not a folded scorer"):
+        NetworkRanker(tmp_path / "text.npz")

@@ -178,6 +178,31 @@ class FoldedScorer:
         arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
         np.savez(path, **arrays)  # type: ignore[arg-type]
 
+    @staticmethod
+    def header(path: str | Path) -> dict[str, Any]:
+        """The configuration `save` wrote beside the arrays, without reading the arrays (an
+        ``.npz`` is a zip: members are read when asked for).
+
+        Raises:
+            ValueError: not a scorer `save` wrote, or one missing a layer's arrays.
+        """
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                meta: dict[str, Any] = json.loads(str(data["meta"]))
+                names = set(data.files)
+        except (OSError, KeyError, ValueError) as e:
+            raise ValueError(f"{path}: not a folded scorer ({e})") from e
+        missing = [
+            f"{name}.{c}.{i}"
+            for name, layout in meta["layout"].items()
+            for c, acts in enumerate(layout)
+            for i in range(len(acts))
+            if f"{name}.{c}.{i}.weight" not in names or f"{name}.{c}.{i}.bias" not in names
+        ]
+        if missing:
+            raise ValueError(f"{path}: a folded scorer without the arrays of {', '.join(missing[:3])}")
+        return meta
+
     @classmethod
     def load(cls, path: str | Path) -> FoldedScorer:
         """The scorer `save` wrote."""
