@@ -343,7 +343,21 @@ def rank_figure(results: dict) -> dict:
         }
         for r in results.get("vs_heuristic", [])
     }
-    return {"guides": guides, "vs_heuristic": ratios}
+    figure = {"guides": guides, "vs_heuristic": ratios}
+    if results.get("by_folder"):
+        figure["by_folder"] = [
+            {
+                "folder": str(r["folder"]),
+                "guide": str(r["guide"]),
+                "designs": int(r["designs"]),
+                "steps": int(r["steps"]),
+                **{m: _rounded(r[m], 4) for m in ("normalised", "top1", "top5")},
+                "vs_heuristic": _rounded(r["vs_heuristic"], 3),
+                "ci": [_rounded(r["ci_low"], 3), _rounded(r["ci_high"], 3)],
+            }
+            for r in results["by_folder"]
+        ]
+    return figure
 
 
 HEAVY_FIELDS = ("folder", "zones", "build_s", "expansion_s", "first_proposals", "ground_truth_s", "labels_s")

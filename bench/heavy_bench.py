@@ -59,9 +59,7 @@ def _measure(entry: CorpusEntry, work: str, level: int, seed: int) -> dict:
     graph = _timed(progress, row, "build", lambda: build_zone_graph(list(r.bodies), samples=0))
     row["zones"] = graph.n_zones
     empty = np.zeros(graph.n_zones, bool)
-    first = _timed(
-        progress, row, "expansion", lambda: ProposalGenerator(graph, level=level).proposals(empty)
-    )
+    first = _timed(progress, row, "expansion", lambda: ProposalGenerator(graph, level=level).proposals(empty))
     row["first_proposals"] = len(first)
     operations = [s["operation"] for s in r.summary()["steps"]]
     tools = [s.tool.wrapped for s in r.steps]

@@ -255,13 +255,61 @@ def ratios(
         if len(sums) != len(base_sums):  # not the same designs: no pairing
             continue
         means = sums[picks, 0].sum(axis=1) / sums[picks, 1].sum(axis=1)
-        ratio = float((sums[:, 0].sum() / sums[:, 1].sum()) / (base_sums[:, 0].sum() / base_sums[:, 1].sum()))
-        with np.errstate(divide="ignore", invalid="ignore"):
+        mean, base_mean = sums[:, 0].sum() / sums[:, 1].sum(), base_sums[:, 0].sum() / base_sums[:, 1].sum()
+        with np.errstate(divide="ignore", invalid="ignore"):  # a base that ranks every GT first
+            ratio = float(mean / base_mean)
             resampled = means / base_means
         finite = resampled[np.isfinite(resampled)]  # a resample where the base ranks every GT first
         low, high = _interval(finite, level) if len(finite) else (float("nan"), float("nan"))
         rows.append({"guide": guide, "base": base, "ratio": ratio, "ci_low": low, "ci_high": high})
     return pd.DataFrame(rows, columns=["guide", "base", "ratio", "ci_low", "ci_high"])
+
+
+def by_folder(
+    ranks: pd.DataFrame, folders: dict[str, str], level: float = 0.9, seed: int = 0
+) -> pd.DataFrame:
+    """Per timeline folder and guide: designs and ranked steps, the mean normalised rank, top-1
+    and top-5, and the normalised rank over the heuristic's with its paired interval (`ratios`
+    within the folder; NaN where the heuristic ranks every GT of the folder first)."""
+    steps = ranked(ranks).assign(folder=lambda f: f["design_id"].map(folders).fillna(""))
+    rows = []
+    for folder, group in steps.groupby("folder", sort=True):
+        paired = ratios(group, level=level, seed=seed).set_index("guide")
+        for guide, at in group.groupby("guide", sort=False):
+            row = {
+                "folder": folder,
+                "guide": guide,
+                "designs": at["design_id"].nunique(),
+                "steps": len(at),
+                **{m: float(at[m].mean()) for m in ("normalised", "top1", "top5")},
+            }
+            for key, field in (("vs_heuristic", "ratio"), ("ci_low", "ci_low"), ("ci_high", "ci_high")):
+                row[key] = float(paired.at[guide, field]) if guide in paired.index else float("nan")
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def folder_markdown(table: pd.DataFrame) -> str:
+    """`by_folder` as a Markdown table."""
+    lines = [
+        "| folder | guide | designs | steps | normalised rank | top-1 | top-5 | / heuristic's (90% CI) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in table.itertuples():
+        ratio = "" if np.isnan(r.vs_heuristic) else f"{r.vs_heuristic:.3f} ({r.ci_low:.3f} - {r.ci_high:.3f})"
+        lines.append(
+            f"| {r.folder} | {r.guide} | {r.designs} | {r.steps} | {r.normalised:.4f} | {r.top1:.3f} | "
+            f"{r.top5:.3f} | {ratio} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def design_folders(designs_table: Path) -> dict[str, str]:
+    """Design id -> timeline folder, from a stage's designs table (``data/gt/designs.parquet``)."""
+    if not designs_table.is_file():
+        return {}
+    table = pd.read_parquet(designs_table, columns=["design_id", "folder"])
+    return dict(zip(table["design_id"], table["folder"].astype(str), strict=True))
 
 
 LEGEND = (
@@ -345,6 +393,12 @@ def main() -> None:
     )
     parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--designs-table",
+        type=Path,
+        default=Path("data/gt/designs.parquet"),
+        help="design ids with their timeline folders, for the table by folder (skipped if absent)",
+    )
     parser.add_argument("--out", type=Path, default=Path("eval_out/rank"))
     args = parser.parse_args()
     seen, _ = trained_projects([GuideSpec.parse(f"net={m}").model or "" for m in args.model])
@@ -359,10 +413,16 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     ranks.to_parquet(args.out / "ranks.parquet", index=False)
     records = {"guides": table.to_dict(orient="records"), "vs_heuristic": ratio.to_dict(orient="records")}
+    text = markdown(table, ratio)
+    folders = design_folders(args.designs_table)
+    if folders:
+        per = by_folder(ranks, folders, seed=args.seed)
+        records["by_folder"] = per.to_dict(orient="records")
+        text += "\nBy timeline folder (steps with more than one proposal):\n\n" + folder_markdown(per)
     (args.out / "rank.json").write_text(json.dumps(records, indent=2))
-    (args.out / "rank.md").write_text(markdown(table, ratio))
+    (args.out / "rank.md").write_text(text)
     plot_ranks(table, args.out / "rank.png")
-    print(markdown(table, ratio))
+    print(text)
 
 
 if __name__ == "__main__":

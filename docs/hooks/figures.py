@@ -359,7 +359,25 @@ def rank(records: list[dict]) -> str:
             "\n\n| run | guide | normalised rank / heuristic's | 90% CI (paired) |\n|---|---|---|---|\n"
             + "\n".join(ratios)
         )
+    folders = [_folder_rows(r) for r in records if r["figure"].get("by_folder")]
+    if folders:
+        text += (
+            "\n\nBy timeline folder (steps with more than one proposal):\n\n| run | folder | guide | designs "
+            "| steps | normalised rank | top-1 | top-5 | / heuristic's (90% CI) |\n"
+            "|---|---|---|---|---|---|---|---|---|\n" + "\n".join(row for rows in folders for row in rows)
+        )
     return text + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def _folder_rows(record: dict) -> list[str]:
+    rows = []
+    for f in record["figure"]["by_folder"]:
+        low, high = f["ci"]
+        ratio = "-" if f["vs_heuristic"] is None else f"{f['vs_heuristic']:.3f} ({low:.3f} - {high:.3f})"
+        cells = [record["name"], f["folder"], f["guide"], str(f["designs"]), str(f["steps"])]
+        cells += [f"{f['normalised']:.4f}", f"{f['top1']:.3f}", f"{f['top5']:.3f}", ratio]
+        rows.append("| " + " | ".join(cells) + " |")
+    return rows
 
 
 HEAVY_COLUMNS = (("zones", 0), ("build_s", 1), ("expansion_s", 2), ("first_proposals", 0), ("labels_s", 1))

@@ -105,3 +105,25 @@ def test_the_summary_counts_single_proposal_steps_and_pairs_ratios(labelled):
     assert guide == "random"
     assert value == pytest.approx(table.loc["random", "normalised"] / table.loc["heuristic", "normalised"])
     assert "normalised rank" in markdown(summarise(ranks), ratio)
+
+
+def test_ranks_by_folder_pair_each_folders_designs_alone():
+    from eval.rank import by_folder, folder_markdown, ratios
+
+    rows = []
+    for design, heuristic, net in [("a", 0.0, 0.0), ("b", 0.4, 0.1), ("c", 0.2, 0.2)]:
+        for guide, value in (("heuristic", heuristic), ("net", net)):
+            rows.append({"guide": guide, "design_id": design, "step": 0, "proposals": 5, "normalised": value})
+            rows.append({"guide": guide, "design_id": design, "step": 1, "proposals": 1, "normalised": 0.0})
+    ranks = pd.DataFrame(rows).assign(top1=lambda f: f["normalised"] == 0, top5=True)
+    table = by_folder(ranks, {"a": "01", "b": "02", "c": "02"}, seed=2).set_index(["folder", "guide"])
+    assert table.loc[("02", "net"), "steps"] == 2 and table.loc[("02", "net"), "designs"] == 2
+    assert table.loc[("02", "net"), "normalised"] == pytest.approx(0.15)
+    expected = ratios(ranks[ranks["design_id"] != "a"], seed=2).set_index("guide").loc["net"]
+    assert table.loc[("02", "net"), "vs_heuristic"] == pytest.approx(0.5) == pytest.approx(expected["ratio"])
+    assert table.loc[("02", "net"), "ci_low"] == expected["ci_low"]
+    assert np.isnan(table.loc[("01", "net"), "vs_heuristic"])  # the heuristic ranks folder 01's GT first
+    assert np.isnan(table.loc[("02", "heuristic"), "vs_heuristic"])
+    text = folder_markdown(by_folder(ranks, {"a": "01", "b": "02", "c": "02"}))
+    assert "| 02 | net | 2 | 2 | 0.1500 | 0.000 | 1.000 | 0.500 (" in text
+    assert "| 01 | net | 1 | 1 | 0.0000 |" in text
