@@ -3,7 +3,7 @@
     python -m bench.guide_cost_bench --graphs data/zonegraphs/graphs --gt data/gt
         [--guides heuristic net=CHECKPOINT net=CHECKPOINT@top_m=8,blend=0.5,margin=0.1 ...]
         [--designs 20] [--budgets 1 5] [--seed 7] [--repeat 1] [--part tune|report]
-        [--out bench_out/guide_cost]
+        [--exclude IDS.txt] [--out bench_out/guide_cost]
 
 Searches the saved (simplified) zone graph of a seeded sample of test designs, stratified by
 timeline folder and none of a project any checkpoint trained on, once per guide and budget, in
@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from eval.guides import GuideSpec
-from eval.heldout import PARTS, held_out, part_of, trained_projects
+from eval.heldout import PARTS, excluded, held_out, part_of, trained_projects
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.proposals import ProposalGenerator
@@ -47,6 +47,7 @@ def chosen_designs(
     seed: int,
     part: str | None = None,
     part_seed: int = 0,
+    exclude: Path | None = None,
 ) -> pd.DataFrame:
     """A seeded sample of ``count`` test designs with a saved graph, stratified by folder, none of a
     project the checkpoints trained on (and of one half of them by project, with ``part``); with
@@ -56,7 +57,7 @@ def chosen_designs(
         (designs["split"] == "test") & designs["design_id"].map(lambda d: (graphs / d).is_dir())
     ]
     seen, _ = trained_projects(models) if models else (set(), [])
-    kept = part_of(held_out(designs["design_id"], seen), part, part_seed)
+    kept = part_of(excluded(held_out(designs["design_id"], seen), exclude), part, part_seed)
     designs = designs[designs["design_id"].isin(kept)]
     designs = designs.sort_values("design_id").reset_index(drop=True)
     return designs.iloc[stratified_sample(designs["folder"].astype(str).tolist(), count, seed)]
@@ -156,11 +157,16 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1, help="runs of each search; the least time counts")
     parser.add_argument("--part", choices=PARTS, default=None, help="one half of the designs by project")
     parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
+    parser.add_argument(
+        "--exclude", type=Path, default=None, help="a text file of design ids to leave out (one per line)"
+    )
     parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))
     args = parser.parse_args()
     guides = [GuideSpec.parse(g) for g in args.guides]
     models = [g.model for g in guides if g.model]
-    designs = chosen_designs(args.gt, args.graphs, models, args.designs, args.seed, args.part, args.part_seed)
+    designs = chosen_designs(
+        args.gt, args.graphs, models, args.designs, args.seed, args.part, args.part_seed, args.exclude
+    )
     print(
         f"guide_cost_bench: {len(designs)} designs: {designs['folder'].value_counts().sort_index().to_dict()}"
     )

@@ -57,6 +57,19 @@ def held_out_labelled(labels_dir: str | Path, split: str, projects: set[str]) ->
     return held_out(sorted(set(ids)), projects)
 
 
+def excluded(design_ids: Sequence[str], listing: Path | None) -> list[str]:
+    """``design_ids`` less those listed in the text file ``listing`` (one id per line; ``#``
+    starts a comment): the designs earlier evaluations looked at, so that a figure can be of
+    designs that never steered a choice. ``None``: all of them."""
+    if listing is None:
+        return list(design_ids)
+    if not listing.is_file():
+        raise SystemExit(f"{listing}: error: no such list of design ids")
+    lines = (line.partition("#")[0].strip() for line in listing.read_text().splitlines())
+    listed = {line for line in lines if line}
+    return [d for d in design_ids if d not in listed]
+
+
 def part_of(design_ids: Sequence[str], part: str | None, seed: int) -> list[str]:
     """One of two halves of ``design_ids`` by project, drawn with ``seed``, in their order: knobs
     of a guide are chosen on ``tune`` and reported on ``report``, so the figure is of designs

@@ -26,7 +26,7 @@ import pandas as pd
 import pyarrow.dataset as ds
 
 from eval.guides import GuideSpec
-from eval.heldout import PARTS, held_out_labelled, part_of, trained_projects
+from eval.heldout import PARTS, excluded, held_out_labelled, part_of, trained_projects
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.sequence.rankers import GTPlace, Ranker, gt_place, make_ranker, score_step
 from zonegraph.zones.model import ZoneGraph
@@ -392,6 +392,9 @@ def main() -> None:
         "--part", choices=PARTS, default=None, help="one half of the designs by project (default: all)"
     )
     parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
+    parser.add_argument(
+        "--exclude", type=Path, default=None, help="a text file of design ids to leave out (one per line)"
+    )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
         "--designs-table",
@@ -402,7 +405,8 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("eval_out/rank"))
     args = parser.parse_args()
     seen, _ = trained_projects([GuideSpec.parse(f"net={m}").model or "" for m in args.model])
-    designs = part_of(held_out_labelled(args.labels, args.split, seen), args.part, args.part_seed)
+    kept = excluded(held_out_labelled(args.labels, args.split, seen), args.exclude)
+    designs = part_of(kept, args.part, args.part_seed)
     designs = designs[: args.limit]
     print(f"rank: {len(designs)} {args.split} designs of no project a model trained on", flush=True)
     ranks = guide_ranks(

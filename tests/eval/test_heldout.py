@@ -23,3 +23,14 @@ def test_two_parts_split_designs_by_project_and_keep_their_order():
     assert part_of(ids, "tune", 3) == tune != part_of(ids, "tune", 4) and part_of(ids, None, 3) == ids
     with pytest.raises(ValueError, match="unknown part"):
         part_of(ids, "test", 0)
+
+
+def test_listed_designs_are_left_out_and_a_missing_list_is_one_line(tmp_path):
+    from eval.heldout import excluded
+
+    listing = tmp_path / "seen.txt"
+    listing.write_text("# looked at before\n10_a_0000\n  30_c_0001  # a comment\n\n")
+    assert excluded(["10_a_0000", "20_b_0000", "30_c_0001"], listing) == ["20_b_0000"]
+    assert excluded(["10_a_0000"], None) == ["10_a_0000"]
+    with pytest.raises(SystemExit, match="missing.txt: error: no such list of design ids"):
+        excluded(["10_a_0000"], tmp_path / "missing.txt")
