@@ -377,7 +377,7 @@ def plot_ranks(table: pd.DataFrame, path: Path) -> Path:
     return path
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     import argparse
     import json
 
@@ -402,16 +402,28 @@ def main() -> None:
         default=Path("data/gt/designs.parquet"),
         help="design ids with their timeline folders, for the table by folder (skipped if absent)",
     )
-    parser.add_argument("--out", type=Path, default=Path("eval_out/rank"))
-    args = parser.parse_args()
-    seen, _ = trained_projects([GuideSpec.parse(f"net={m}").model or "" for m in args.model])
-    kept = excluded(held_out_labelled(args.labels, args.split, seen), args.exclude)
-    designs = part_of(kept, args.part, args.part_seed)
-    designs = designs[: args.limit]
-    print(f"rank: {len(designs)} {args.split} designs of no project a model trained on", flush=True)
-    ranks = guide_ranks(
-        args.labels, args.graphs, make_guides(args.guides, args.model, args.seed), args.split, designs
+    parser.add_argument(
+        "--ranks",
+        type=Path,
+        default=None,
+        help="summarise an earlier run's ranks.parquet (less --exclude, --part) instead of ranking",
     )
+    parser.add_argument("--out", type=Path, default=Path("eval_out/rank"))
+    args = parser.parse_args(argv)
+    if args.ranks is not None:
+        earlier = pd.read_parquet(args.ranks)
+        kept = excluded(sorted(set(earlier["design_id"])), args.exclude)
+        ranks = earlier[earlier["design_id"].isin(part_of(kept, args.part, args.part_seed)[: args.limit])]
+        print(f"rank: {ranks['design_id'].nunique()} designs of {args.ranks}", flush=True)
+    else:
+        seen, _ = trained_projects([GuideSpec.parse(f"net={m}").model or "" for m in args.model])
+        kept = excluded(held_out_labelled(args.labels, args.split, seen), args.exclude)
+        designs = part_of(kept, args.part, args.part_seed)[: args.limit]
+        print(f"rank: {len(designs)} {args.split} designs of no project a model trained on", flush=True)
+        guides = make_guides(args.guides, args.model, args.seed)
+        ranks = guide_ranks(args.labels, args.graphs, guides, args.split, designs)
+    if ranks.empty:
+        raise SystemExit("rank: error: no designs left to rank")
     table = summarise(ranks, seed=args.seed)
     ratio = ratios(ranks, seed=args.seed)
     args.out.mkdir(parents=True, exist_ok=True)

@@ -127,3 +127,26 @@ def test_ranks_by_folder_pair_each_folders_designs_alone():
     text = folder_markdown(by_folder(ranks, {"a": "01", "b": "02", "c": "02"}))
     assert "| 02 | net | 2 | 2 | 0.1500 | 0.000 | 1.000 | 0.500 (" in text
     assert "| 01 | net | 1 | 1 | 0.0000 |" in text
+
+
+def test_an_earlier_runs_ranks_are_summarised_again_without_the_listed_designs(tmp_path):
+    import json
+
+    from eval.rank import main
+
+    rows = [
+        {"guide": guide, "design_id": design, "step": 0, "proposals": 4, "normalised": value}
+        for design, heuristic, net in [("1_a_0000", 0.4, 0.1), ("2_b_0000", 0.2, 0.2), ("3_c_0000", 0.3, 0.0)]
+        for guide, value in (("heuristic", heuristic), ("net", net))
+    ]
+    ranks = pd.DataFrame(rows).assign(rank=0.5, floor=0.25, top1=False, top5=True, above=1, ties=0)
+    ranks.to_parquet(tmp_path / "ranks.parquet")
+    (tmp_path / "seen.txt").write_text("3_c_0000\n")
+    out, earlier = tmp_path / "again", str(tmp_path / "ranks.parquet")
+    main(["--ranks", earlier, "--exclude", str(tmp_path / "seen.txt"), "--out", str(out)])
+    result = json.loads((out / "rank.json").read_text())
+    assert {g["guide"]: g["designs"] for g in result["guides"]} == {"heuristic": 2, "net": 2}
+    assert result["vs_heuristic"][0]["ratio"] == pytest.approx(0.15 / 0.3)
+    (tmp_path / "all.txt").write_text("1_a_0000\n2_b_0000\n3_c_0000\n")
+    with pytest.raises(SystemExit, match="no designs left to rank"):
+        main(["--ranks", earlier, "--exclude", str(tmp_path / "all.txt")])
