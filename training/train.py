@@ -43,6 +43,7 @@ import numpy as np
 import pyarrow.dataset as ds
 import torch
 from torch_geometric.loader import DataLoader
+from tqdm import tqdm
 
 from training.data import LabelDataset
 from training.loss import LOSSES, distilled_weight, focal_loss, listwise_loss
@@ -434,7 +435,8 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
             t0 = time.perf_counter()
             model.train()
             losses = []
-            for batch in train_loader:
+            desc = f"train: epoch {epoch}/{config.epochs}"
+            for batch in tqdm(train_loader, desc=desc, unit="batch", mininterval=5):
                 batch = batch.to(device)
                 if len(batch.y) < 2:  # BatchNorm needs two examples
                     continue
