@@ -34,7 +34,7 @@ import pandas as pd
 import zonegraph.network
 from eval.curves import at_time, curves, plot_curves, time_grid
 from eval.dvc_metrics import rounded, write_guides
-from eval.heldout import held_out, held_out_labelled, trained_projects
+from eval.heldout import excluded, held_out, held_out_labelled, trained_projects
 from eval.programs import program_measures
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, ranked, ratios, summarise
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
@@ -137,7 +137,7 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
         return pd.DataFrame(), "No rank-only labels for these designs: the rank needs the labels stage.\n"
     rankers = make_guides(["random", "heuristic"], [g.model for g in guides if g.model], args.seed)
     rankers = {g.name: r for g, r in zip(guides, rankers.values(), strict=True)}
-    designs = held_out_labelled(labels, args.designs, args.trained)[: args.limit]
+    designs = excluded(held_out_labelled(labels, args.designs, args.trained), args.exclude)[: args.limit]
     ranks = guide_ranks(labels, graphs, rankers, args.designs, designs)
     ranks.to_parquet(out / "ranks.parquet", index=False)
     table = summarise(ranks, seed=args.seed)
@@ -191,7 +191,7 @@ def search_section(
         if Path(args.designs).is_dir()
         else split_targets(args.designs, args.project)
     )
-    kept = set(held_out([t.design_id for t in targets], args.trained))
+    kept = set(excluded(held_out([t.design_id for t in targets], args.trained), args.exclude))
     targets = [
         t
         for t in targets
@@ -372,6 +372,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--min-gt-length", type=int, default=d["min_gt_length"])
     parser.add_argument("--strips", type=int, default=d["strips"], help="designs drawn as sequence strips")
     parser.add_argument("--limit", type=int, default=d["limit"], help="the first N designs only")
+    parser.add_argument(
+        "--exclude", type=Path, default=None, help="a text file of design ids to leave out (one per line)"
+    )
     parser.add_argument("--workers", type=int, default=d["workers"])
     parser.add_argument(
         "--timeout",
