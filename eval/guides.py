@@ -36,8 +36,9 @@ class GuideSpec:
         if unknown:
             raise SystemExit(f"{spec}: unknown option {sorted(unknown)} ({', '.join(KNOBS)})")
         knobs = tuple((k, KNOBS[k](v)) for k, v in sorted(options.items()))
-        shipped = Path(model).name == "scorer.pt" and Path(model).parent.name == "checkpoints"
-        short = "shipped" if shipped else Path(model).parent.name or model
+        path = Path(model)
+        shipped = not model or (path.stem == "scorer" and path.parent.name == "checkpoints")
+        short = "shipped" if shipped else path.parent.name or model
         label = f"net:{short}" + (f"@{settings}" if settings else "")
         return cls(label, "net", model or None, knobs)
 

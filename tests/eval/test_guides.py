@@ -21,6 +21,9 @@ def test_a_network_spec_carries_its_knobs_to_the_ranker():
     ranker = spec.ranker(0)
     assert isinstance(ranker, NetworkRanker) and (ranker.top_m, ranker.blend) == (4, 0.25)
     assert GuideSpec.parse("heuristic") == GuideSpec("heuristic", "heuristic")
+    assert spec.label == "net:shipped@top_m=4,blend=0.25"
+    assert GuideSpec.parse("net").label == GuideSpec.parse("net=").label == "net:shipped"
+    assert GuideSpec.parse("net=runs/whole/scorer.npz").label == "net:whole"
     with pytest.raises(SystemExit, match="unknown option"):
         GuideSpec.parse("net=x.pt@depth=3")
 
