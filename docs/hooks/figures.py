@@ -11,6 +11,7 @@ before its results file was kept, with the commit that added it.
 from __future__ import annotations
 
 import json
+import math
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -372,8 +373,10 @@ def rank(records: list[dict]) -> str:
 def _folder_rows(record: dict) -> list[str]:
     rows = []
     for f in record["figure"]["by_folder"]:
-        low, high = f["ci"]
-        ratio = "-" if f["vs_heuristic"] is None else f"{f['vs_heuristic']:.3f} ({low:.3f} - {high:.3f})"
+        value, (low, high) = f["vs_heuristic"], f["ci"]
+        ratio = "-"  # the heuristic ranks every GT of the folder first
+        if value is not None and math.isfinite(value):
+            ratio = f"{value:.3f}" + ("" if low is None else f" ({low:.3f} - {high:.3f})")
         cells = [record["name"], f["folder"], f["guide"], str(f["designs"]), str(f["steps"])]
         cells += [f"{f['normalised']:.4f}", f"{f['top1']:.3f}", f"{f['top5']:.3f}", ratio]
         rows.append("| " + " | ".join(cells) + " |")

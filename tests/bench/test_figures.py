@@ -296,11 +296,13 @@ def test_the_rank_figure_keeps_every_scale_with_its_interval_and_the_ratio():
     folder = {"folder": "08_21plus", "guide": "net", "designs": 3, "steps": 9, "normalised": 0.03551}
     folder |= {"top1": 0.7, "top5": 1.0, "vs_heuristic": 0.2577, "ci_low": 0.1, "ci_high": 0.45}
     first = {**folder, "folder": "01_2ops", "vs_heuristic": float("nan"), "ci_low": float("nan")}
-    figure = rank_figure(results | {"by_folder": [first, folder]})
-    assert figure["by_folder"][1]["vs_heuristic"] == 0.258 and figure["by_folder"][0]["vs_heuristic"] is None
+    random = {**first, "guide": "random", "vs_heuristic": float("inf"), "ci_high": float("nan")}
+    figure = rank_figure(results | {"by_folder": [first, random, folder]})
+    assert figure["by_folder"][2]["vs_heuristic"] == 0.258 and figure["by_folder"][0]["vs_heuristic"] is None
     table = _hook().rank([record | {"figure": figure}])
     assert "| run | 08_21plus | net | 3 | 9 | 0.0355 | 0.700 | 1.000 | 0.258 (0.100 - 0.450) |" in table
     assert "| run | 01_2ops | net | 3 | 9 | 0.0355 | 0.700 | 1.000 | - |" in table
+    assert "| run | 01_2ops | random | 3 | 9 | 0.0355 | 0.700 | 1.000 | - |" in table
 
 
 def test_the_heavy_figure_shows_each_stage_before_and_after_and_what_ran_out_of_time():
