@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 import torch
@@ -203,3 +205,17 @@ def test_a_folded_scorer_missing_its_arrays_is_refused_when_opened(tmp_path):
     (tmp_path / "text.npz").write_text("not a zip")
     with pytest.raises(ValueError, match="text.npz: not a folded scorer"):
         NetworkRanker(tmp_path / "text.npz")
+
+
+def test_the_training_projects_are_kept_beside_a_small_header(tmp_path):
+    """A guide reads only the header when it is made; the projects an evaluation must leave out
+    (thousands of ids) are their own member, and files that kept them in the header still load."""
+    shipped = FoldedScorer.load(SHIPPED_FOLDED)
+    assert len(shipped.train_projects) > 1000
+    assert "train_projects" not in FoldedScorer.header(SHIPPED_FOLDED)
+    with np.load(SHIPPED_FOLDED) as data:
+        arrays = {k: data[k] for k in data.files if k != "train_projects"}
+    meta = json.loads(str(arrays["meta"])) | {"train_projects": list(shipped.train_projects)}
+    arrays["meta"] = np.array(json.dumps(meta))
+    np.savez(tmp_path / "older.npz", **arrays)
+    assert FoldedScorer.load(tmp_path / "older.npz").train_projects == shipped.train_projects

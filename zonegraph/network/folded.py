@@ -173,9 +173,9 @@ class FoldedScorer:
             "layout": layout,
             "points_per_zone": self.points_per_zone,
             "search": self.search,
-            "train_projects": list(self.train_projects),
         }
         arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
+        arrays["train_projects"] = np.array(self.train_projects, dtype=str)
         np.savez(path, **arrays)  # type: ignore[arg-type]
 
     @staticmethod
@@ -208,6 +208,9 @@ class FoldedScorer:
         """The scorer `save` wrote."""
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
+            # their own member, so that a guide reads a small header (older files: in the header)
+            own = "train_projects" in data.files
+            projects = data["train_projects"] if own else meta.get("train_projects", ())
             chains = {
                 name: tuple(
                     tuple(
@@ -229,7 +232,7 @@ class FoldedScorer:
             features=chains["features"][0] if chains["features"] else (),
             points_per_zone=meta["points_per_zone"],
             search=meta["search"],
-            train_projects=tuple(meta.get("train_projects", ())),
+            train_projects=tuple(str(p) for p in projects),
         )
 
     def _chains(self) -> dict[str, tuple[Chain, ...]]:
