@@ -360,6 +360,50 @@ def rank_figure(results: dict) -> dict:
     return figure
 
 
+def _stage(table: pd.DataFrame, status: str, seconds: str) -> dict:
+    """Designs by status and the job seconds of one stage's table (its sum and median)."""
+    counts = table[status].fillna("not run").astype(str).value_counts()
+    done = table[seconds].dropna()
+    return {
+        "designs": len(table),
+        "statuses": {str(k): int(v) for k, v in counts.items()},
+        "job_seconds": round(float(done.sum()), 1),
+        "median_seconds": _rounded(done.median(), 3) if len(done) else None,
+    }
+
+
+def pipeline_run_figure(project: Path) -> dict:
+    """A pipeline run's stages from what they wrote (``data/``, ``models/``): designs by status and
+    job seconds per stage, the labels' counts and the training's best epoch. Walls are not among
+    the stages' outputs (a resumed stage's pieces run sessions apart)."""
+    data = project / "data"
+    stages = {
+        "generate": _stage(pd.read_parquet(data / "designs/conversion.parquet"), "status", "seconds"),
+        "replay": _stage(pd.read_parquet(data / "replay/manifest.parquet"), "status", "seconds"),
+        "zonegraphs": _stage(pd.read_parquet(data / "zonegraphs/manifest.parquet"), "status", "job_seconds"),
+    }
+    gt = pd.read_parquet(data / "gt/designs.parquet")
+    stages["ground_truth"] = _stage(gt[gt["gt_seconds"].notna()], "simplified_status", "gt_seconds")
+    labels = json.loads((data / "details/labels.json").read_text())
+    for key, name in (("rank_only", "labels (rank-only)"), ("", "labels (with completions)")):
+        part = labels.get(key, {}) if key else labels
+        if part.get("designs"):
+            stages[name] = {
+                "designs": int(part["designs"]),
+                "statuses": {str(k): int(v) for k, v in part["by_status"].items()},
+                "job_seconds": round(float(part["seconds"]), 1),
+                "median_seconds": part.get("seconds_per_design_median"),
+                "steps": int(part["steps"]),
+                "labelled_steps": int(part["labelled_steps"]),
+                "proposals": int(part["proposals"]),
+            }
+    best = project / "models/best.json"
+    train = json.loads(best.read_text()) if best.is_file() else None
+    if train is not None:
+        train = {k: train[k] for k in ("epoch", "val_normalised", "val_rank", "run_id") if k in train}
+    return {"stages": stages, "train": train}
+
+
 HEAVY_FIELDS = ("folder", "zones", "build_s", "expansion_s", "first_proposals", "ground_truth_s", "labels_s")
 
 
@@ -418,9 +462,9 @@ def write_figure(
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("kind", choices=[*FIGURES_OF, "fusion-diff", "report"])
+    ap.add_argument("kind", choices=[*FIGURES_OF, "fusion-diff", "report", "pipeline-run"])
     ap.add_argument("name", help="the figure's file name under --out, without .json")
-    ap.add_argument("results", type=Path, help="the benchmark's results.json")
+    ap.add_argument("results", type=Path, help="the benchmark's results.json (a project, for pipeline-run)")
     ap.add_argument("--command", required=True, help="the command that wrote RESULTS")
     ap.add_argument("--commit", default=None, help="the commit it measured (default: HEAD)")
     ap.add_argument("--measured", default=date.today().isoformat(), help="the day it ran (default: today)")
@@ -428,6 +472,8 @@ def main() -> None:
     args = ap.parse_args()
     if args.kind == "report":
         figure = report_figure(args.results)
+    elif args.kind == "pipeline-run":
+        figure = pipeline_run_figure(args.results)
     else:
         coverage = args.kind == "coverage"
         data = pd.read_parquet(args.results) if coverage else json.loads(args.results.read_text())

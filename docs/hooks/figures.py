@@ -410,6 +410,44 @@ def heavy(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+STAGE_ORDER = (
+    "generate",
+    "replay",
+    "zonegraphs",
+    "ground_truth",
+    "labels (rank-only)",
+    "labels (with completions)",
+)
+
+
+def pipeline_run(records: list[dict]) -> str:
+    """A pipeline run's stages: designs, job seconds (sum and median per design) and designs by
+    status, as the stages wrote them; the labels' counts and the training's best epoch below."""
+    (r,) = records
+    stages, lines = (
+        r["figure"]["stages"],
+        ["| stage | designs | job seconds (median) | by status |", "|---|---|---|---|"],
+    )
+    for name in [n for n in STAGE_ORDER if n in stages]:
+        st = stages[name]
+        median = "" if st["median_seconds"] is None else f" ({st['median_seconds']:.3f})"
+        statuses = ", ".join(f"{k} {v:,}" for k, v in sorted(st["statuses"].items(), key=lambda kv: -kv[1]))
+        lines.append(f"| {name} | {st['designs']:,} | {st['job_seconds']:,.0f}{median} | {statuses} |")
+    notes = [
+        f"- {name}: {st['steps']:,} GT steps, {st['labelled_steps']:,} labelled, "
+        f"{st['proposals']:,} proposals"
+        for name, st in stages.items()
+        if "steps" in st
+    ]
+    train = r["figure"].get("train")
+    if train:
+        notes.append(
+            f"- train: best epoch {train['epoch']}, validation normalised rank "
+            f"{train['val_normalised']:.4f}, MLflow run `{train['run_id']}`"
+        )
+    return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
 RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "build": build,
     "search": search,
@@ -425,6 +463,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "report": report,
     "rank": rank,
     "heavy": heavy,
+    "pipeline-run": pipeline_run,
 }
 
 

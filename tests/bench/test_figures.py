@@ -17,6 +17,7 @@ from bench.figures import (
     fuzz_figure,
     guide_cost_figure,
     heavy_figure,
+    pipeline_run_figure,
     rank_figure,
     report_figure,
 )
@@ -320,3 +321,37 @@ def test_the_heavy_figure_shows_each_stage_before_and_after_and_what_ran_out_of_
     table = _hook().heavy(records)
     row = next(line for line in table.splitlines() if line.startswith("| d1 |"))
     assert "13.7 → 15.0" in row and "280 → 579" in row and "169.1 → > 1,800 (timeout)" in row
+
+
+def test_a_pipeline_run_figure_reads_each_stage_from_what_it_wrote(tmp_path):
+    """Designs by status and job seconds per stage from the stages' own tables; a design the
+    ground truth never reached (no seconds) is not one of its designs."""
+    data = tmp_path / "data"
+    for folder in ("designs", "replay", "zonegraphs", "gt", "details"):
+        (data / folder).mkdir(parents=True)
+    pd.DataFrame({"status": ["ok", "ok", "mismatch"], "seconds": [1.0, 3.0, 0.5]}).to_parquet(
+        data / "designs/conversion.parquet"
+    )
+    pd.DataFrame({"status": ["ok", "ok"], "seconds": [0.2, 0.4]}).to_parquet(data / "replay/manifest.parquet")
+    graphs = pd.DataFrame({"status": ["ok", "timeout"], "job_seconds": [0.1, 300.0]})
+    graphs.to_parquet(data / "zonegraphs/manifest.parquet")
+    gt = pd.DataFrame({"simplified_status": ["ok", None, None], "gt_seconds": [0.1, None, None]})
+    gt.to_parquet(data / "gt/designs.parquet")
+    rank_only = {"designs": 1, "by_status": {"ok": 1}, "seconds": 0.09, "seconds_per_design_median": 0.09}
+    rank_only |= {"steps": 2, "labelled_steps": 1, "proposals": 7}
+    (data / "details/labels.json").write_text(json.dumps({"designs": 0, "rank_only": rank_only}))
+    figure = pipeline_run_figure(tmp_path)
+    stages = figure["stages"]
+    assert stages["generate"] == {
+        "designs": 3,
+        "statuses": {"ok": 2, "mismatch": 1},
+        "job_seconds": 4.5,
+        "median_seconds": 1.0,
+    }
+    assert stages["zonegraphs"]["statuses"] == {"ok": 1, "timeout": 1}
+    assert stages["ground_truth"]["designs"] == 1
+    assert "labels (with completions)" not in stages and figure["train"] is None
+    record = {"name": "run", "command": "dvc repro", "commit": "abc1234", "measured": "2026-12-06"}
+    table = _hook().pipeline_run([record | {"figure": figure}])
+    assert "| generate | 3 | 4 (1.000) | ok 2, mismatch 1 |" in table
+    assert "- labels (rank-only): 2 GT steps, 1 labelled, 7 proposals" in table
