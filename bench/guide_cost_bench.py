@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from eval.guides import GuideSpec
-from eval.heldout import PARTS, excluded, held_out, part_of, trained_projects
+from eval.heldout import PARTS, add_exclude, excluded, held_out, part_of, trained_projects
 from zonegraph.data.dataset import stratified_sample
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.proposals import ProposalGenerator
@@ -157,9 +157,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=1, help="runs of each search; the least time counts")
     parser.add_argument("--part", choices=PARTS, default=None, help="one half of the designs by project")
     parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
-    parser.add_argument(
-        "--exclude", type=Path, default=None, help="a text file of design ids to leave out (one per line)"
-    )
+    add_exclude(parser)
     parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))
     args = parser.parse_args()
     guides = [GuideSpec.parse(g) for g in args.guides]

@@ -9,6 +9,7 @@ every design of those projects for every guide, so all guides are compared on th
 
 from __future__ import annotations
 
+import argparse
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -55,6 +56,13 @@ def held_out_labelled(labels_dir: str | Path, split: str, projects: set[str]) ->
     steps = ds.dataset(Path(labels_dir) / "steps", format="parquet").to_table(columns=["design_id", "split"])
     ids = steps.filter(ds.field("split") == split).column("design_id").to_pylist()
     return held_out(sorted(set(ids)), projects)
+
+
+def add_exclude(parser: argparse.ArgumentParser) -> None:
+    """The ``--exclude`` option `excluded` reads, for every command that draws test designs."""
+    parser.add_argument(
+        "--exclude", type=Path, default=None, help="a text file of design ids to leave out (one per line)"
+    )
 
 
 def excluded(design_ids: Sequence[str], listing: Path | None) -> list[str]:

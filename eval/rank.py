@@ -26,7 +26,7 @@ import pandas as pd
 import pyarrow.dataset as ds
 
 from eval.guides import GuideSpec
-from eval.heldout import PARTS, excluded, held_out_labelled, part_of, trained_projects
+from eval.heldout import PARTS, add_exclude, excluded, held_out_labelled, part_of, trained_projects
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.sequence.rankers import GTPlace, Ranker, gt_place, make_ranker, score_step
 from zonegraph.zones.model import ZoneGraph
@@ -305,10 +305,13 @@ def folder_markdown(table: pd.DataFrame) -> str:
 
 
 def design_folders(designs_table: Path) -> dict[str, str]:
-    """Design id -> timeline folder, from a stage's designs table (``data/gt/designs.parquet``)."""
+    """Design id -> timeline folder, from a stage's designs table (``data/gt/designs.parquet``,
+    ``data/designs/index.parquet``); empty where the table or its folders are absent."""
     if not designs_table.is_file():
         return {}
-    table = pd.read_parquet(designs_table, columns=["design_id", "folder"])
+    table = pd.read_parquet(designs_table)
+    if "folder" not in table:
+        return {}
     return dict(zip(table["design_id"], table["folder"].astype(str), strict=True))
 
 
@@ -392,9 +395,7 @@ def main(argv: list[str] | None = None) -> None:
         "--part", choices=PARTS, default=None, help="one half of the designs by project (default: all)"
     )
     parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
-    parser.add_argument(
-        "--exclude", type=Path, default=None, help="a text file of design ids to leave out (one per line)"
-    )
+    add_exclude(parser)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
         "--designs-table",

@@ -34,9 +34,18 @@ import pandas as pd
 import zonegraph.network
 from eval.curves import at_time, curves, plot_curves, time_grid
 from eval.dvc_metrics import rounded, write_guides
-from eval.heldout import excluded, held_out, held_out_labelled, trained_projects
+from eval.heldout import add_exclude, excluded, held_out, held_out_labelled, trained_projects
 from eval.programs import program_measures
-from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, ranked, ratios, summarise
+from eval.rank import (
+    design_folders,
+    guide_ranks,
+    make_guides,
+    markdown,
+    plot_ranks,
+    ranked,
+    ratios,
+    summarise,
+)
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
 from eval.strips import pick_designs, write_strips
 from zonegraph.configs import Config, ConfigError, InferConfig, load_section
@@ -144,7 +153,7 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
     ratio = ratios(ranks, seed=args.seed)
     plot_ranks(table, out / "rank.png")
     text = "## Relative GT rank\n\n" + markdown(table, ratio) + "\n![rank](rank.png)\n"
-    folders = _folders(args)
+    folders = design_folders(Path(args.project) / "data/designs/index.parquet")
     if folders:
         ranks["folder"] = ranks["design_id"].map(folders).fillna("")
         steps = ranked(ranks)
@@ -162,16 +171,6 @@ def _ratio_columns(table: pd.DataFrame, ratio: pd.DataFrame) -> dict[str, list[f
         f"vs_heuristic{suffix}": [getattr(by[g], field) if g in by else nan for g in table["guide"]]
         for suffix, field in (("", "ratio"), ("_ci_low", "ci_low"), ("_ci_high", "ci_high"))
     }
-
-
-def _folders(args: argparse.Namespace) -> dict[str, str]:
-    index = Path(args.project) / "data/designs/index.parquet"
-    if not index.is_file():
-        return {}
-    table = pd.read_parquet(index)
-    return (
-        dict(zip(table["design_id"], table["folder"].astype(str), strict=True)) if "folder" in table else {}
-    )
 
 
 def _frame_md(frame: pd.DataFrame) -> str:
@@ -372,9 +371,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--min-gt-length", type=int, default=d["min_gt_length"])
     parser.add_argument("--strips", type=int, default=d["strips"], help="designs drawn as sequence strips")
     parser.add_argument("--limit", type=int, default=d["limit"], help="the first N designs only")
-    parser.add_argument(
-        "--exclude", type=Path, default=None, help="a text file of design ids to leave out (one per line)"
-    )
+    add_exclude(parser)
     parser.add_argument("--workers", type=int, default=d["workers"])
     parser.add_argument(
         "--timeout",

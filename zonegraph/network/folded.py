@@ -190,15 +190,15 @@ class FoldedScorer:
             with np.load(path, allow_pickle=False) as data:
                 meta: dict[str, Any] = json.loads(str(data["meta"]))
                 names = set(data.files)
-        except (OSError, KeyError, ValueError) as e:
+            layers = [
+                f"{name}.{c}.{i}"
+                for name, layout in meta["layout"].items()
+                for c, acts in enumerate(layout)
+                for i in range(len(acts))
+            ]
+        except (OSError, KeyError, TypeError, ValueError) as e:
             raise ValueError(f"{path}: not a folded scorer ({e})") from e
-        missing = [
-            f"{name}.{c}.{i}"
-            for name, layout in meta["layout"].items()
-            for c, acts in enumerate(layout)
-            for i in range(len(acts))
-            if f"{name}.{c}.{i}.weight" not in names or f"{name}.{c}.{i}.bias" not in names
-        ]
+        missing = [layer for layer in layers if not {f"{layer}.weight", f"{layer}.bias"} <= names]
         if missing:
             raise ValueError(f"{path}: a folded scorer without the arrays of {', '.join(missing[:3])}")
         return meta

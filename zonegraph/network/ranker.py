@@ -99,9 +99,8 @@ class LazyScorer:
     """A folded scorer (``.npz``) whose weights are read when it first scores a state.
 
     Most corpus designs are solved in one expansion whose completing step is taken unscored, so
-    the network is never called on them; holding its loaded weights still left those searches
-    about 1% slower than the heuristic's (53 one-expansion corpus test designs, least of five
-    alternating runs: 1.011 against 0.999 of the heuristic's time with the weights unread). Only
+    the network is never called on them, and a search that never needs the weights should not
+    pay for holding them (measured: docs/results/network.md, "Search at equal wall-clock"). Only
     the header is read up front: the knobs, the features to compute and the samples per zone.
     """
 
