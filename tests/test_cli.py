@@ -198,7 +198,7 @@ def test_help_lists_commands_in_use_order_with_defaults_choices_and_examples(cap
     with pytest.raises(SystemExit):
         main(["--help"])
     top = capsys.readouterr().out
-    assert "{infer,build,replay,convert}" in top and "examples:" in top and "``" not in top
+    assert "{infer,build,replay,convert,server}" in top and "examples:" in top and "``" not in top
     with pytest.raises(SystemExit):
         main(["infer", "--help"])
     text = " ".join(capsys.readouterr().out.split())

@@ -363,6 +363,7 @@ EPILOG = """examples:
   zonegraph build part.step --out graph/          # the zone graph: Parquet, zones.brep, zones.ply
   zonegraph replay design.json --out replay/      # a Fusion 360 Gallery design rebuilt as STEP
   zonegraph convert corpus/01_2ops --out json/    # build123d corpus batches to design JSON
+  zonegraph server start                          # later calls skip the start-up (server stop)
 
 A batch names each part's folder by its file stem, or by its file name where two files share a
 stem (Couch.json and Couch.step go to Couch.json/ and Couch.step/).
@@ -386,11 +387,12 @@ def build_parser() -> argparse.ArgumentParser:
         prog="zonegraph", description=DESCRIPTION, epilog=EPILOG, formatter_class=_HelpFormatter
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="{infer,build,replay,convert}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="{infer,build,replay,convert,server}")
     _add_infer(sub)
     _add_build(sub)
     _add_replay(sub)
     _add_convert(sub)
+    _add_server(sub)
     return parser
 
 
@@ -495,6 +497,32 @@ def _add_convert(sub: Any) -> None:
     p.set_defaults(func=_cmd_convert)
 
 
+def _add_server(sub: Any) -> None:
+    p = _command(sub, "server", "keep the geometry kernel loaded between calls (start, stop, status)")
+    p.add_argument("action", choices=("start", "stop", "status"))
+    p.add_argument(
+        "--idle", type=float, default=15.0, help="minutes without a call after which the server stops"
+    )
+    p.add_argument("--json", action="store_true", help="print the server's status as JSON")
+    p.set_defaults(func=_cmd_server)
+
+
+def _cmd_server(args: argparse.Namespace) -> int:
+    from zonegraph import server
+
+    actions = {"start": lambda: server.start(args.idle * 60), "stop": server.stop, "status": server.status}
+    try:
+        state = actions[args.action]()
+    except server.ServerError as exc:
+        print(f"zonegraph: error: {exc}", file=sys.stderr)
+        return EXIT_USER_ERROR
+    if args.json:
+        print(json.dumps(state))
+    else:
+        print(server.describe(args.action, state))
+    return 0 if state is not None or args.action != "status" else 1
+
+
 def _add_memory(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--memory",
@@ -515,6 +543,7 @@ POSITIVE = {
     "max_depth": "--max-depth",
     "tolerance": "--tolerance",
     "memory": "--memory",
+    "idle": "--idle",
 }
 
 
@@ -526,7 +555,7 @@ def argument_error(args: argparse.Namespace) -> str | None:
             return f"{flag} {value}: must be a positive number"
     if getattr(args, "samples", 0) < 0 or getattr(args, "level", 1) < 1:
         return "--samples must be 0 or more and --level 1 or more"
-    return out_error(Path(args.out))
+    return out_error(Path(args.out)) if hasattr(args, "out") else None
 
 
 def out_error(out: Path) -> str | None:
@@ -540,21 +569,35 @@ def out_error(out: Path) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run a command; ``argv`` None means this process is the command (the console script)."""
-    args = build_parser().parse_args(argv)
-    args.own_process = argv is None  # in-process callers' objects must stay collectable
+    """Run a command; ``argv`` None means this process is the command (the console script), which
+    then hands it to a warm server of this code where one runs (`zonegraph.server`)."""
+    return run(argv, own_process=argv is None, warm=argv is None)
+
+
+def run(argv: Sequence[str] | None = None, own_process: bool = True, warm: bool = False) -> int:
+    """Run a command here (``warm``: in a running server if there is one). ``own_process``: this
+    process ends with the command, so its objects need not stay collectable."""
+    arguments = list(sys.argv[1:] if argv is None else argv)
+    args = build_parser().parse_args(arguments)
+    args.own_process = own_process
     func: Callable[[argparse.Namespace], int] = args.func
     error = argument_error(args)
     if error:
         print(f"zonegraph: error: {error}", file=sys.stderr)
         return EXIT_USER_ERROR
+    if warm and args.command != "server":
+        from zonegraph.server import forward
+
+        status = forward(arguments)
+        if status is not None:
+            return status
     try:
         return func(args)
     except ZoneGraphError as exc:
         print(f"zonegraph: error: {exc}", file=sys.stderr)
         return EXIT_USER_ERROR
     finally:
-        if argv is None:
+        if own_process:
             _skip_final_collection()
 
 
