@@ -422,6 +422,23 @@ def heavy_figure(rows: list[dict]) -> dict:
     }
 
 
+def startup_figure(results: Path) -> dict:
+    """The start-up benchmark by part: each process's CPU, wall and peak memory per column (ours
+    cold, ours handed to a server, the original), and the server's own start where it ran."""
+    rows = json.loads(results.read_text())
+    start = results.parent / "server_start.json"
+    columns = [c for c in rows[0] if isinstance(rows[0][c], dict)] if rows else []
+    parts = {
+        r["part"]: {"folder": r["folder"], "step_bytes": r["step_bytes"], **{c: r[c] for c in columns}}
+        for r in rows
+    }
+    return {
+        "columns": columns,
+        "parts": parts,
+        "server_start": json.loads(start.read_text()) if start.is_file() else None,
+    }
+
+
 FIGURES_OF = {
     "build": build_figure,
     "search": search_figure,
@@ -462,7 +479,7 @@ def write_figure(
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("kind", choices=[*FIGURES_OF, "fusion-diff", "report", "pipeline-run"])
+    ap.add_argument("kind", choices=[*FIGURES_OF, "fusion-diff", "report", "pipeline-run", "startup"])
     ap.add_argument("name", help="the figure's file name under --out, without .json")
     ap.add_argument("results", type=Path, help="the benchmark's results.json (a project, for pipeline-run)")
     ap.add_argument("--command", required=True, help="the command that wrote RESULTS")
@@ -474,6 +491,8 @@ def main() -> None:
         figure = report_figure(args.results)
     elif args.kind == "pipeline-run":
         figure = pipeline_run_figure(args.results)
+    elif args.kind == "startup":
+        figure = startup_figure(args.results)
     else:
         coverage = args.kind == "coverage"
         data = pd.read_parquet(args.results) if coverage else json.loads(args.results.read_text())

@@ -3,17 +3,21 @@
     python -m bench.startup_bench [--designs data/designs/json] [--per-folder 3] [--seed 7]
                                   [--exclude FILE] [--budget 1] [--guide heuristic] [--no-infer]
                                   [--original DIR] [--freecad-python PY] [--original-deps DIR]
-                                  [--timeout 600] [--out bench_out/startup]
+                                  [--timeout 600] [--server] [--out bench_out/startup]
 
 The parts: ``--per-folder`` designs of each timeline folder of the build123d corpus (``../shared``),
 drawn with ``--seed`` from those whose converted JSON is in ``--designs`` and whose id is not in
 ``--exclude`` (one id a line; a validation sample must never steer tuning), plus the Couch sample.
 Each is replayed once to ``PART.step`` (centimetres declared), the input both sides read.
 
-Each part then runs as its own process, as a user's single call does: ``python -m zonegraph.cli
-build PART.step`` (and ``infer PART.step --budget B --guide G``), measured by ``os.wait4``: CPU seconds (user
-+ sys of the process and every child it reaped, so a loaded machine does not inflate them), wall
-seconds and peak resident memory (the largest of the process and its children). The original
+Each part then runs as its own process, as a user's single call does: ``python -m zonegraph
+build PART.step`` (and ``infer PART.step --budget B --guide G``), cold (``ZONEGRAPH_NO_SERVER``),
+measured by ``os.wait4``: CPU seconds (user + sys of the process and every child it reaped, so a
+loaded machine does not inflate them), wall seconds and peak resident memory (the largest of the
+process and its children). With ``--server`` a ``zonegraph server`` is started once (its start
+measured apart) and each command runs again handed to it (the ``warm`` columns): the calling
+process's CPU plus the call's child in the server, as the server reports its last call (its peak
+resident memory counts the pages it shares with the server). The original
 implementation (brownvc/zone-graphs on FreeCAD) runs the same way when ``--original`` names its
 checkout and FreeCAD's Python module imports under ``--freecad-python`` (Debian's
 ``freecad-python3`` package, for the system's ``/usr/bin/python3``): one process that reads the STEP
@@ -28,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import random
 import resource
@@ -136,21 +141,65 @@ def original_problem(original: Path | None, python: str, paths: list[str]) -> st
     return None
 
 
-def run_part(step: Path, work: Path, args: argparse.Namespace, original_ok: bool) -> dict:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    cli = [sys.executable, "-m", "zonegraph.cli"]
+@dataclass(frozen=True)
+class Warm:
+    """A running ``zonegraph server`` (its folder and socket) that warm calls are handed to."""
+
+    folder: Path
+    socket: str
+
+    def env(self) -> dict[str, str]:
+        return {**os.environ, "PYTHONPATH": str(ROOT), "ZONEGRAPH_SERVER_DIR": str(self.folder)}
+
+
+def start_server(work: Path) -> tuple[Warm, dict]:
+    """A server in a private folder of ``work``; its start measured: the starting command's own
+    process, and the server's CPU and memory once it answers."""
+    folder = work / "servers"
+    warm = Warm(folder, "")
+    cmd = [sys.executable, "-m", "zonegraph.cli", "server", "start", "--json"]
+    with tempfile.TemporaryFile() as out:
+        t0 = time.perf_counter()
+        subprocess.run(cmd, cwd=ROOT, env=warm.env(), stdout=out, check=True)
+        wall = time.perf_counter() - t0
+        out.seek(0)
+        state = json.loads(out.read())
+    start = {"wall_s": wall, "server_cpu_s": state["cpu_s"], "server_mb": state["peak_mb"]}
+    return Warm(folder, state["socket"]), start
+
+
+def measure_warm(cmd: list[str], warm: Warm, timeout: float) -> Run:
+    """``cmd`` handed to the server: the calling process (``measure``) plus the call's child in
+    the server (its CPU and peak resident memory, as the server's status reports its last call)."""
+    from zonegraph.handoff import ask
+
+    caller = measure(cmd, ROOT, warm.env(), timeout)
+    state = ask("status", warm.socket)
+    call = (state or {}).get("last_call") or {"cpu_s": math.nan, "peak_mb": math.nan}
+    peak = max(caller.peak_mb, call["peak_mb"])
+    return Run(caller.rc, caller.cpu_s + call["cpu_s"], caller.wall_s, peak, caller.tail)
+
+
+def run_part(step: Path, work: Path, args: argparse.Namespace, original_ok: bool, warm: Warm | None) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "ZONEGRAPH_NO_SERVER": "1"}
+    cli = [sys.executable, "-m", "zonegraph"]  # as the console script
     row: dict = {"part": step.stem, "step_bytes": step.stat().st_size}
     runs = {"build": cli + ["build", str(step), "--out", str(work / f"{step.stem}_build")]}
     if not args.no_infer:
         budget = ["--budget", str(args.budget), "--guide", args.guide]
         runs["infer"] = cli + ["infer", str(step), "--out", str(work / f"{step.stem}_infer"), *budget]
+    if warm is not None:
+        runs |= {f"{name} warm": [*cmd[:-1], f"{cmd[-1]}_warm"] for name, cmd in list(runs.items())}
     if original_ok:
         src = args.original / "src"
         code = ORIGINAL_DRIVER.format(src=str(src), paths=original_paths(args), step=str(step))
         runs["original"] = [args.freecad_python, "-c", code]
     for name, cmd in runs.items():
         original = name == "original"
-        run = measure(cmd, src if original else ROOT, None if original else env, args.timeout)
+        if name.endswith(" warm") and warm is not None:
+            run = measure_warm(cmd, warm, args.timeout)
+        else:
+            run = measure(cmd, src if original else ROOT, None if original else env, args.timeout)
         row[name] = asdict(run)
         print(
             f"  {step.stem} {name}: rc {run.rc}, cpu {run.cpu_s:.2f} s, wall {run.wall_s:.2f} s, "
@@ -185,9 +234,14 @@ def table(rows: list[dict], columns: list[str], skipped: str | None) -> str:
     )
     if skipped:
         lines.append(f"\noriginal implementation skipped: {skipped}")
-    if "original" in columns:
-        worse = [r["part"] for r in rows if r["build"]["cpu_s"] > r["original"]["cpu_s"]]
-        lines.append(f"\nparts whose build CPU exceeds the original's: {worse or 'none'}")
+    for ours in ("build", "build warm"):
+        if "original" in columns and ours in columns:
+            worse = [r["part"] for r in rows if r[ours]["cpu_s"] > r["original"]["cpu_s"]]
+            ratios = [r[ours]["cpu_s"] / r["original"]["cpu_s"] for r in rows]
+            lines.append(
+                f"\n{ours}: CPU / the original's, median {statistics.median(ratios):.2f} "
+                f"({min(ratios):.2f}-{max(ratios):.2f}); parts above the original's: {worse or 'none'}"
+            )
     return "\n".join(lines)
 
 
@@ -222,6 +276,7 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--freecad-python", default="/usr/bin/python3", help="the Python that imports FreeCAD")
     p.add_argument("--original-deps", type=Path, default=None, help="a folder holding trimesh for it")
     p.add_argument("--timeout", type=float, default=600, help="seconds before a process is killed")
+    p.add_argument("--server", action="store_true", help="also each call handed to a zonegraph server")
     p.add_argument("--out", type=Path, default=ROOT / "bench_out" / "startup")
     p.add_argument("--prepare", type=Path, default=None, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
@@ -229,15 +284,34 @@ def main(argv: list[str] | None = None) -> None:
         return _prepare_here(args)
     skipped = original_problem(args.original, args.freecad_python, original_paths(args))
     columns = ["build"] + ([] if args.no_infer else ["infer"]) + ([] if skipped else ["original"])
-    rows = []
+    if args.server:
+        columns[1 if args.no_infer else 2 : 0] = [f"{c} warm" for c in columns if c in ("build", "infer")]
+    rows, started = [], None
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         parts = prepare(args, work)
         print(f"{len(parts)} parts; columns {columns}; original skipped: {skipped or 'no'}")
         print(f"this process: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB peak")
-        for folder, step in parts:
-            rows.append({"folder": folder, **run_part(step, work, args, skipped is None)})
-    write_results(rows, table(rows, columns, skipped), args.out)
+        warm, started = start_server(work) if args.server else (None, None)
+        if started:
+            print(f"server started: {started}")
+        try:
+            for folder, step in parts:
+                rows.append({"folder": folder, **run_part(step, work, args, skipped is None, warm)})
+        finally:
+            if warm is not None:
+                from zonegraph.handoff import ask
+
+                ask("stop", warm.socket)
+    text = table(rows, columns, skipped)
+    if started:
+        text += (
+            f"\n\nthe server's start, once: {started['wall_s']:.2f} s wall, {started['server_cpu_s']:.2f} "
+            f"CPU s and {started['server_mb']:.0f} MB in the server"
+        )
+    write_results(rows, text, args.out)
+    if started:
+        (args.out / "server_start.json").write_text(json.dumps(started))
 
 
 if __name__ == "__main__":

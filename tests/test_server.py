@@ -20,7 +20,7 @@ import pytest
 from zonegraph.testing import SAMPLES
 
 COUCH = SAMPLES / "Couch.step"
-CLI = [sys.executable, "-m", "zonegraph.cli"]
+CLI = [sys.executable, "-m", "zonegraph"]  # as the console script: a call is handed to a server
 
 
 @pytest.fixture(scope="module")
@@ -134,7 +134,7 @@ def test_a_socket_nobody_listens_on_means_a_cold_call(tmp_path: Path) -> None:
     try:
         folder.mkdir(mode=0o700)
         probe = subprocess.run(
-            [sys.executable, "-c", "from zonegraph.server import socket_path; print(socket_path())"],
+            [sys.executable, "-c", "from zonegraph.handoff import socket_path; print(socket_path())"],
             env=_env(folder),
             capture_output=True,
             text=True,

@@ -568,36 +568,24 @@ def out_error(out: Path) -> str | None:
     return None
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run a command; ``argv`` None means this process is the command (the console script), which
-    then hands it to a warm server of this code where one runs (`zonegraph.server`)."""
-    return run(argv, own_process=argv is None, warm=argv is None)
-
-
-def run(argv: Sequence[str] | None = None, own_process: bool = True, warm: bool = False) -> int:
-    """Run a command here (``warm``: in a running server if there is one). ``own_process``: this
-    process ends with the command, so its objects need not stay collectable."""
-    arguments = list(sys.argv[1:] if argv is None else argv)
-    args = build_parser().parse_args(arguments)
-    args.own_process = own_process
+def main(argv: Sequence[str] | None = None, own_process: bool | None = None) -> int:
+    """Run a command; ``argv`` None means this process is the command (the console script).
+    ``own_process`` (default: ``argv`` is None): the process ends with the command, so its
+    objects need not stay collectable (a warm server's child passes its own ``argv``)."""
+    args = build_parser().parse_args(argv)
+    args.own_process = argv is None if own_process is None else own_process
     func: Callable[[argparse.Namespace], int] = args.func
     error = argument_error(args)
     if error:
         print(f"zonegraph: error: {error}", file=sys.stderr)
         return EXIT_USER_ERROR
-    if warm and args.command != "server":
-        from zonegraph.server import forward
-
-        status = forward(arguments)
-        if status is not None:
-            return status
     try:
         return func(args)
     except ZoneGraphError as exc:
         print(f"zonegraph: error: {exc}", file=sys.stderr)
         return EXIT_USER_ERROR
     finally:
-        if own_process:
+        if args.own_process:
             _skip_final_collection()
 
 

@@ -3,12 +3,12 @@
 Every call of the command line pays to start before it reads a part: the interpreter, numpy,
 pyarrow and OCP's one extension module, whose initialisation alone registers every bound class of
 OpenCASCADE (docs/results/benchmarks.md, "Where the floor is") and costs more CPU than the original
-implementation's whole process on a small part. ``zonegraph server start`` pays that once. While a
-server runs, a call of ``build``, ``infer``, ``replay`` or ``convert`` imports none of the kernel: it
-connects to the server's socket and hands over its arguments, working folder, environment, umask
-and its standard streams (file descriptors, passed with ``SCM_RIGHTS``); the server forks a child
-that runs the command as that call's own process would, writing to the caller's terminal, and the
-child's exit status becomes the call's.
+implementation's whole process on a small part. ``zonegraph server start`` pays that once. While
+a server runs, a call of ``build``, ``infer``, ``replay`` or ``convert`` imports none of the kernel:
+it connects to the server's socket (`zonegraph.handoff`, the calling side) and hands over its
+arguments, working folder, environment, umask and its standard streams (file descriptors, passed
+with ``SCM_RIGHTS``); the server forks a child that runs the command as that call's own process
+would, writing to the caller's terminal, and the child's exit status becomes the call's.
 
 Why a fork per call rather than a thread: every call starts from the same warm, untouched copy of
 the server (copy-on-write), so one call's state, a crash or a hung OpenCASCADE call cannot reach the
@@ -26,8 +26,6 @@ Settings that libraries read when imported (thread counts, say) are the server's
 
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 import selectors
 import signal
@@ -35,18 +33,17 @@ import socket
 import struct
 import subprocess
 import sys
-import tempfile
 import time
 import traceback
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from zonegraph.handoff import ask, directory, fingerprint, receive, send, socket_path
+
 IDLE_S = 900.0  # a server with no call for this long stops
 START_TIMEOUT_S = 120.0
-OFF = "ZONEGRAPH_NO_SERVER"
-DIRECTORY = "ZONEGRAPH_SERVER_DIR"
 # What the commands import before their first part, imported once by the server.
 WARM = (
     "zonegraph.batch",
@@ -58,23 +55,10 @@ WARM = (
     "zonegraph.network.ranker",
     "build123d",
 )
-_HEADER = struct.Struct("!I")
 
 
 class ServerError(Exception):
     """A server cannot be started, reached or stopped; the message says why."""
-
-
-def directory() -> Path:
-    """The private folder of this user's servers: ``$ZONEGRAPH_SERVER_DIR``, else
-    ``$XDG_RUNTIME_DIR/zonegraph``, else ``zonegraph-<uid>`` in the temporary folder."""
-    chosen = os.environ.get(DIRECTORY)
-    if chosen:
-        return Path(chosen)
-    runtime = os.environ.get("XDG_RUNTIME_DIR")
-    if runtime:
-        return Path(runtime) / "zonegraph"
-    return Path(tempfile.gettempdir()) / f"zonegraph-{os.getuid()}"
 
 
 def private(folder: Path) -> Path:
@@ -84,132 +68,6 @@ def private(folder: Path) -> Path:
     if info.st_uid != os.getuid() or info.st_mode & 0o077:
         raise ServerError(f"{folder}: not a private folder of this user (mode {info.st_mode & 0o777:o})")
     return folder
-
-
-def fingerprint() -> str:
-    """What a server's code is: the interpreter, the distributions installed beside it (their
-    folders' names carry their versions) and this package's files (path, size, modification)."""
-    digest = hashlib.sha256(sys.executable.encode())
-    for entry in sys.path:
-        if entry.endswith("-packages") and os.path.isdir(entry):
-            digest.update(" ".join(sorted(n for n in os.listdir(entry) if n.endswith("-info"))).encode())
-    for path in sorted(Path(__file__).parent.rglob("*.py")):
-        info = path.stat()
-        digest.update(f"{path}:{info.st_size}:{info.st_mtime_ns}".encode())
-    return digest.hexdigest()[:16]
-
-
-def socket_path() -> Path:
-    return directory() / f"{fingerprint()}.sock"
-
-
-def _send(sock: socket.socket, message: dict[str, Any], fds: Sequence[int] = ()) -> None:
-    data = json.dumps(message).encode()
-    framed = _HEADER.pack(len(data)) + data
-    if fds:
-        framed = framed[socket.send_fds(sock, [framed], list(fds)) :]
-    if framed:  # an empty send to a peer that has read and closed would fail
-        sock.sendall(framed)
-
-
-def _receive(sock: socket.socket, max_fds: int = 0) -> tuple[dict[str, Any] | None, list[int]]:
-    """One framed message and the descriptors sent with it; None when the peer closed first."""
-    data, fds = b"", list[int]()
-    while len(data) < _HEADER.size or len(data) < _HEADER.size + _HEADER.unpack_from(data)[0]:
-        if max_fds and not fds:
-            chunk, got, _, _ = socket.recv_fds(sock, 65536, max_fds)
-            fds = list(got)
-        else:
-            chunk = sock.recv(65536)
-        if not chunk:
-            for fd in fds:
-                os.close(fd)
-            return None, []
-        data += chunk
-    return json.loads(data[_HEADER.size :]), fds
-
-
-def _connect(path: Path, timeout: float | None = None) -> socket.socket | None:
-    """A connection to the server at ``path``, or None where none listens (a stale socket file)."""
-    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-    sock.settimeout(timeout)
-    try:
-        sock.connect(str(path))
-    except OSError:
-        sock.close()
-        return None
-    return sock
-
-
-def ask(op: str, path: Path | None = None, timeout: float = 10.0) -> dict[str, Any] | None:
-    """The server's answer to ``status`` or ``stop``; None when no server of this code runs."""
-    sock = _connect(path or socket_path(), timeout)
-    if sock is None:
-        return None
-    with sock:
-        _send(sock, {"op": op})
-        answer, _ = _receive(sock)
-    return answer
-
-
-# The calling side --------------------------------------------------------------------------------
-
-
-def forward(argv: Sequence[str]) -> int | None:
-    """Run ``zonegraph ARGV`` in the warm server and return its exit status; None when no server
-    of this code runs (or ``ZONEGRAPH_NO_SERVER`` is set): the caller then runs it itself."""
-    if os.environ.get(OFF):
-        return None
-    try:
-        path = socket_path()
-    except OSError:
-        return None
-    sock = _connect(path) if path.exists() else None
-    if sock is None:
-        return None
-    with sock:
-        umask = os.umask(0o022)
-        os.umask(umask)
-        request = {
-            "op": "run",
-            "argv": list(argv),
-            "cwd": os.getcwd(),
-            "env": dict(os.environ),
-            "umask": umask,
-        }
-        _send(sock, request, (0, 1, 2))
-        started, _ = _receive(sock)
-        if started is None or "pid" not in started:
-            return None
-        with _forwarding_signals(started["pid"]):
-            ended, _ = _receive(sock)
-    if ended is None:
-        print(f"zonegraph: error: the server ({path}) ended during the call (a bug)", file=sys.stderr)
-        return 1
-    return int(ended["rc"])
-
-
-class _forwarding_signals:
-    """Ctrl-C, hang-up and termination of the caller go to the call's process group instead."""
-
-    SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-
-    def __init__(self, pid: int) -> None:
-        self.pid = pid
-        self.saved: dict[int, Any] = {}
-
-    def _pass_on(self, signum: int, _frame: object) -> None:
-        try:
-            os.killpg(self.pid, signum)
-        except ProcessLookupError:
-            pass
-
-    def __enter__(self) -> None:
-        self.saved = {s: signal.signal(s, self._pass_on) for s in self.SIGNALS}
-
-    def __exit__(self, *_exc: object) -> None:
-        for s, handler in self.saved.items():
-            signal.signal(s, handler)
 
 
 # The serving side --------------------------------------------------------------------------------
@@ -222,6 +80,7 @@ class _Calls:
     running: dict[int, socket.socket] = field(default_factory=dict)
     served: int = 0
     last: float = field(default_factory=time.monotonic)
+    ended: dict[str, Any] | None = None  # the last call's exit status, CPU seconds and peak memory
 
 
 def warm() -> None:
@@ -313,7 +172,7 @@ def _accept(
     if not _same_user(conn):
         conn.close()
         return
-    request, fds = _receive(conn, max_fds=3)
+    request, fds = receive(conn, max_fds=3)
     if request is None:
         conn.close()
         return
@@ -324,7 +183,7 @@ def _accept(
             _child(request, fds, selector, conn, wake)
         for fd in fds:
             os.close(fd)
-        _send(conn, {"pid": pid})
+        send(conn, {"pid": pid})
         calls.running[pid] = conn
         selector.register(conn, selectors.EVENT_READ, pid)
         return
@@ -332,7 +191,7 @@ def _accept(
         os.close(fd)
     if request.get("op") == "stop":
         stopping.append(True)
-    _send(conn, _status(calls, started))
+    send(conn, _status(calls, started))
     conn.close()
 
 
@@ -357,6 +216,7 @@ def _status(calls: _Calls, started: float) -> dict[str, Any]:
         "cpu_s": own.ru_utime + own.ru_stime,
         "children_cpu_s": children.ru_utime + children.ru_stime,
         "peak_mb": own.ru_maxrss / 1024,
+        "last_call": calls.ended,
     }
 
 
@@ -383,9 +243,13 @@ def _reap(selector: selectors.BaseSelector, calls: _Calls) -> None:
         calls.served += 1
         calls.last = time.monotonic()
         _forget(selector, conn)
-        ended = {"rc": os.waitstatus_to_exitcode(status), "cpu_s": use.ru_utime + use.ru_stime}
+        calls.ended = {
+            "rc": os.waitstatus_to_exitcode(status),
+            "cpu_s": use.ru_utime + use.ru_stime,  # the call's child and the workers it reaped
+            "peak_mb": use.ru_maxrss / 1024,  # resident, the pages it shares with the server included
+        }
         try:
-            _send(conn, {**ended, "peak_mb": use.ru_maxrss / 1024})
+            send(conn, calls.ended)
         except OSError:
             pass
         conn.close()
@@ -443,9 +307,9 @@ def _child(
         os.environ.clear()
         os.environ.update(request["env"])
         os.umask(int(request["umask"]))
-        from zonegraph.cli import run
+        from zonegraph.cli import main
 
-        status = run(request["argv"])
+        status = main(request["argv"], own_process=True)
     except SystemExit as exc:  # argparse's own exits
         status = exc.code if isinstance(exc.code, int) else 2
     except KeyboardInterrupt:
@@ -483,8 +347,8 @@ def _stream(fd: int) -> Any:
 
 def start(idle_s: float = IDLE_S) -> dict[str, Any]:
     """A server of this code, started unless one runs; its status once it answers."""
-    path = private(directory()) / f"{fingerprint()}.sock"
-    running = ask("status", path)
+    path = private(Path(directory())) / f"{fingerprint()}.sock"
+    running = ask("status", str(path))
     if running is not None:
         return {**running, "socket": str(path), "already": True}
     log = path.with_suffix(".log")
@@ -494,7 +358,7 @@ def start(idle_s: float = IDLE_S) -> dict[str, Any]:
             cmd, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT, start_new_session=True
         )
     for _ in _until(START_TIMEOUT_S):
-        answer = ask("status", path)
+        answer = ask("status", str(path))
         if answer is not None:
             return {**answer, "socket": str(path), "already": False}
         if proc.poll() is not None:
@@ -537,7 +401,7 @@ def stop() -> dict[str, Any] | None:
     if answer is None:
         return None
     for _ in _until(30.0):
-        if not path.exists():
+        if not os.path.exists(path):
             break
     return answer
 

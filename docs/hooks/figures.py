@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import statistics
 from collections.abc import Callable
 from pathlib import Path
 
@@ -448,6 +449,50 @@ def pipeline_run(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def startup(records: list[dict]) -> str:
+    """One ``zonegraph build`` per part as its own process, cold and handed to a server, beside
+    the original's: CPU seconds, wall seconds and peak memory, the medians, and how ours compare."""
+    (r,) = records
+    f = r["figure"]
+    columns, parts = f["columns"], f["parts"]
+    head = " | ".join(f"{c} CPU s | {c} wall s | {c} MB" for c in columns)
+    lines = [f"| part (folder) | {head} |", "|---|" + "---|" * (3 * len(columns))]
+
+    def cells(run: dict) -> list[str]:
+        failed = "" if run["rc"] == 0 else f" (exit {run['rc']})"
+        return [f"{run['cpu_s']:.2f}{failed}", f"{run['wall_s']:.2f}", f"{run['peak_mb']:.0f}"]
+
+    for name, part in parts.items():
+        lines.append(_row(f"{name} ({part['folder']})", [x for c in columns for x in cells(part[c])]))
+    medians = [
+        format(statistics.median([p[c][key] for p in parts.values()]), fmt)
+        for c in columns
+        for key, fmt in (("cpu_s", ".2f"), ("wall_s", ".2f"), ("peak_mb", ".0f"))
+    ]
+    lines.append(_row(f"**median of {len(parts)}**", [f"**{m}**" for m in medians]))
+    exits = {c: sum(p[c]["rc"] == 0 for p in parts.values()) for c in columns}
+    notes = [f"- {c}: {n} of {len(parts)} exited 0" for c, n in exits.items()]
+    for ours in [c for c in columns if c != "original" and "original" in columns]:
+        ratios = [p[ours]["cpu_s"] / p["original"]["cpu_s"] for p in parts.values()]
+        above, spread = sum(x > 1 for x in ratios), f"{min(ratios):.2f}-{max(ratios):.2f}"
+        notes.append(
+            f"- {ours} CPU / the original's: median {statistics.median(ratios):.2f} ({spread}), "
+            f"above the original's on {above} of {len(ratios)} parts"
+        )
+    smallest = min(parts, key=lambda n: parts[n]["step_bytes"])
+    notes.append(
+        f"- smallest part by STEP size, {smallest}: "
+        + ", ".join(f"{c} {parts[smallest][c]['wall_s']:.2f} s wall" for c in columns)
+    )
+    start = f.get("server_start")
+    if start:
+        notes.append(
+            f"- the server's start, once: {start['wall_s']:.2f} s wall, {start['server_cpu_s']:.2f} CPU s "
+            f"and {start['server_mb']:.0f} MB resident in the server"
+        )
+    return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
 RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "build": build,
     "search": search,
@@ -464,6 +509,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "rank": rank,
     "heavy": heavy,
     "pipeline-run": pipeline_run,
+    "startup": startup,
 }
 
 
