@@ -20,6 +20,7 @@ from bench.figures import (
     pipeline_run_figure,
     rank_figure,
     report_figure,
+    startup_figure,
 )
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -355,3 +356,32 @@ def test_a_pipeline_run_figure_reads_each_stage_from_what_it_wrote(tmp_path):
     table = _hook().pipeline_run([record | {"figure": figure}])
     assert "| generate | 3 | 4 (1.000) | ok 2, mismatch 1 |" in table
     assert "- labels (rank-only): 2 GT steps, 1 labelled, 7 proposals" in table
+
+
+def test_a_startup_figure_compares_cold_and_warm_calls_with_the_original(tmp_path):
+    """Per part the three processes' CPU, wall and memory; the ratios to the original count a
+    part above it, and a killed original keeps its exit status in the table."""
+
+    def run(cpu: float, rc: int = 0) -> dict:
+        return {"rc": rc, "cpu_s": cpu, "wall_s": cpu + 0.01, "peak_mb": 300.0, "tail": ""}
+
+    rows = [
+        {"folder": "01", "part": "small", "step_bytes": 10, "build": run(1.4), "build warm": run(0.2)}
+        | {"original": run(0.4)},
+        {"folder": "08", "part": "heavy", "step_bytes": 90, "build": run(17.0), "build warm": run(16.0)}
+        | {"original": run(9.0)},
+        {"folder": "03", "part": "hung", "step_bytes": 50, "build": run(9.5), "build warm": run(8.9)}
+        | {"original": run(300.0, rc=-9)},
+    ]
+    (tmp_path / "results.json").write_text(json.dumps(rows))
+    start = {"wall_s": 3.5, "server_cpu_s": 3.4, "server_mb": 480}
+    (tmp_path / "server_start.json").write_text(json.dumps(start))
+    figure = startup_figure(tmp_path / "results.json")
+    assert figure["columns"] == ["build", "build warm", "original"]
+    record = {"name": "s", "command": "python -m bench.startup_bench --server", "commit": "abc1234"}
+    table = _hook().startup([record | {"measured": "2026-12-06", "figure": figure}])
+    assert "| hung (03) | 9.50 | 9.51 | 300 | 8.90 | 8.91 | 300 | 300.00 (exit -9) | 300.01 | 300 |" in table
+    ratios = "median 0.50 (0.03-1.78), above the original's on 1 of 3"
+    assert f"- build warm CPU / the original's: {ratios}" in table
+    assert "- original: 2 of 3 exited 0" in table and "smallest part by STEP size, small" in table
+    assert "the server's start, once: 3.50 s wall, 3.40 CPU s and 480 MB" in table
