@@ -9,7 +9,8 @@ and combined, ranked on held-out designs.
 
 A variant is a ``+``-joined list of changes to the ``train`` section of the params (the ``base``):
 ``focal`` / ``listwise`` (the objective), ``features`` / ``no_features`` (every proposal feature of
-`FEATURES`, or none), ``late`` / ``early`` (the fusion),
+`PROPOSAL_FEATURES`, or none), ``state_features`` (those and the `STATE_FEATURES`), ``late`` /
+``early`` (the fusion),
 ``points`` / ``no_points`` (the zones' point geometry), ``roundsN``, ``hiddenN`` (the width of
 every layer) and ``teacher`` (the listwise target shared with ``--teacher``'s scores: a student
 distilled from a trained checkpoint); e.g. ``listwise+features+early`` or
@@ -38,14 +39,15 @@ from typing import Any
 from eval.heldout import PARTS, held_out_labelled, part_of, trained_projects
 from eval.rank import guide_ranks, make_guides, markdown, plot_ranks, ratios, summarise
 from training.train import TrainConfig, train
-from zonegraph.sequence.features import FEATURES
+from zonegraph.sequence.features import PROPOSAL_FEATURES, STATE_FEATURES
 
 from .params import section
 
 CHANGES: dict[str, dict[str, Any]] = {  # a variant's tokens, as overrides of the base
     "focal": {"loss": "focal", "neutral_credit": None},
     "listwise": {"loss": "listwise"},
-    "features": {"features": FEATURES},
+    "features": {"features": PROPOSAL_FEATURES},
+    "state_features": {"features": PROPOSAL_FEATURES + STATE_FEATURES},
     "no_features": {"features": ()},
     "late": {"fusion": "late"},
     "early": {"fusion": "early"},

@@ -21,7 +21,7 @@ from torch_geometric.data import Dataset
 
 from training.shards import label_shards
 from zonegraph.network.encoding import Geometry, StateData, geometry_of, state_data
-from zonegraph.sequence.features import FEATURES
+from zonegraph.sequence.features import FEATURES, PROPOSAL_FEATURES, with_state_features
 from zonegraph.zones.storage import load_zone_graph
 
 
@@ -68,7 +68,7 @@ class LabelDataset(Dataset):
         self.mode, self.max_proposals, self.seed, self.neutrals = mode, max_proposals, seed, neutrals
         shards = label_shards(labels_dir)
         table = ds.dataset(shards.proposals, format="parquet").to_table()
-        self.has_features = all(f"feat_{name}" in table.column_names for name in FEATURES)
+        self.has_features = all(f"feat_{name}" in table.column_names for name in PROPOSAL_FEATURES)
         steps = ds.dataset(shards.steps, format="parquet").to_table()
         if design_ids is not None:
             wanted = set(design_ids)
@@ -102,7 +102,7 @@ class LabelDataset(Dataset):
     def _features(self, rows) -> np.ndarray:
         if not self.has_features:
             return np.zeros((len(rows), len(FEATURES)), np.float32)
-        return rows[[f"feat_{name}" for name in FEATURES]].to_numpy(np.float32, copy=True)
+        return with_state_features(rows[[f"feat_{name}" for name in PROPOSAL_FEATURES]].to_numpy(np.float32))
 
     def len(self) -> int:
         return len(self.states)

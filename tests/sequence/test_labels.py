@@ -142,7 +142,7 @@ def test_real_samples_keep_the_invariants_and_write_readable_shards(samples_dir,
 
 
 def test_proposal_features_are_the_heuristic_terms_and_the_geometry_the_search_sees():
-    from zonegraph.sequence.features import FEATURES, proposal_features
+    from zonegraph.sequence.features import FEATURES, PROPOSAL_FEATURES, proposal_features
     from zonegraph.sequence.rankers import HeuristicRanker
 
     graph, ops, steps = _labelled(PLATE - HOLE_A, [PLATE, HOLE_A], ["new_body", "cut"], multiplier=0)
@@ -164,10 +164,18 @@ def test_proposal_features_are_the_heuristic_terms_and_the_geometry_the_search_s
         )
         # the plate is 1 thick in a box of unit diagonal: every plate-high extrusion has one depth
         assert gt[column["depth"]] > 0 and gt[column["sketch_area"]] > 0 and gt[column["sketch_faces"]] >= 1
+        # how far behind the state's best: 0 for the best, the heuristic's order for the others
+        agree_gap = feats[:, column["agree_gap"]]
+        assert agree_gap.min() == 0 and (agree_gap >= 0).all()
+        np.testing.assert_allclose(
+            agree_gap, feats[:, column["agree_after"]].max() - feats[:, column["agree_after"]]
+        )
+        assert feats[np.argmax(heuristic), column["iou_gap"]] == 0
     first, second = steps[0].features, steps[1].features
     assert (first[:, column["missing"]] == 1).all() and (second[:, column["missing"]] == 0).all()
     table, _ = label_tables(steps, ops, "part", "train")
-    assert [f"feat_{n}" for n in FEATURES] == table.column_names[-len(FEATURES) :]
+    # the stored columns; the state's own are derived from them whenever a state is read
+    assert [f"feat_{n}" for n in PROPOSAL_FEATURES] == table.column_names[-len(PROPOSAL_FEATURES) :]
 
 
 @requires_samples

@@ -254,11 +254,12 @@ def test_an_ablation_variant_trains_once_then_is_reused(labelled, tmp_path, monk
 
 
 def test_an_ablation_variant_is_the_base_with_its_changes_each_alone_and_combined():
-    from zonegraph.sequence.features import FEATURES
+    from zonegraph.sequence.features import FEATURES, PROPOSAL_FEATURES
 
     base = TrainConfig(loss="focal", features=(), fusion="late", use_points=True, rounds=3)
     combined = variant(base, "listwise+features+early+no_points+rounds1")
-    assert (combined.loss, combined.features, combined.fusion) == ("listwise", FEATURES, "early")
+    assert (combined.loss, combined.features, combined.fusion) == ("listwise", PROPOSAL_FEATURES, "early")
+    assert variant(base, "state_features").features == FEATURES
     assert (combined.use_points, combined.rounds) == (False, 1)
     assert variant(base, "base") == base and variant(combined, "focal").neutral_credit is None
     specs = default_specs(base, [1, 3])

@@ -17,7 +17,7 @@ import numpy as np
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.zones.model import ZoneGraph
 
-FEATURES: tuple[str, ...] = (
+PROPOSAL_FEATURES: tuple[str, ...] = (
     "agree_after",  # the heuristic's first term: share of zones agreeing with the target after the step
     "agree_gain",  # ... minus the same share before it
     "iou_after",  # volumetric IoU with the target after the step (the heuristic's tie-break)
@@ -31,6 +31,23 @@ FEATURES: tuple[str, ...] = (
     "step",  # the state's depth: operations already applied (the GT step index in the labels)
     "missing",  # share of the target's volume the canvas still lacks
 )
+# A scorer reads each proposal apart from the others of its state, so on its own it cannot tell the
+# heuristic's first choice from a runner-up of equal merit; these say how far a proposal is behind
+# the best of the proposals scored with it. Computed from the stored columns whenever a state's
+# proposals are read (`with_state_features`), never stored: older label shards serve them too.
+STATE_FEATURES: tuple[str, ...] = (
+    "agree_gap",  # the state's best agree_after minus this proposal's
+    "iou_gap",  # the state's best iou_after minus this proposal's
+)
+FEATURES: tuple[str, ...] = PROPOSAL_FEATURES + STATE_FEATURES
+
+
+def with_state_features(proposal: np.ndarray) -> np.ndarray:
+    """(P, len(FEATURES)): a state's (P, len(PROPOSAL_FEATURES)) columns and the state's own."""
+    agree = proposal[:, PROPOSAL_FEATURES.index("agree_after")]
+    iou = proposal[:, PROPOSAL_FEATURES.index("iou_after")]
+    gaps = [agree.max(initial=0.0) - agree, iou.max(initial=0.0) - iou]
+    return np.concatenate([proposal, np.stack(gaps, axis=1)], axis=1).astype(np.float32)
 
 
 def target_surfaces(graph: ZoneGraph) -> np.ndarray:
@@ -68,7 +85,8 @@ def proposal_features(
     step: int,
     on_target: np.ndarray | None = None,
 ) -> np.ndarray:
-    """(P, len(FEATURES)) float32: the features of every proposal of one state.
+    """(P, len(FEATURES)) float32: the features of every proposal of one state, those relative to
+    the state taken over ``proposals``.
 
     Args:
         canvas: (Z,) bool, the state's canvas.
@@ -99,4 +117,4 @@ def proposal_features(
         np.full(len(proposals), float(step)),
         np.full(len(proposals), missing),
     ]
-    return np.stack([np.asarray(c, np.float64) for c in columns], axis=1).astype(np.float32)
+    return with_state_features(np.stack([np.asarray(c, np.float64) for c in columns], axis=1))

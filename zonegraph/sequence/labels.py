@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pyarrow as pa
 
-from zonegraph.sequence.features import FEATURES, proposal_features, target_surfaces
+from zonegraph.sequence.features import FEATURES, PROPOSAL_FEATURES, proposal_features, target_surfaces
 from zonegraph.sequence.memo import Memo
 from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
@@ -60,7 +60,7 @@ PROPOSAL_SCHEMA = pa.schema(
         ("p", pa.float32()),  # share of completions reaching the target; null for the GT
         ("completions", pa.int32()),
         ("is_gt", pa.bool_()),
-        *((f"feat_{name}", pa.float32()) for name in FEATURES),  # zonegraph.sequence.features
+        *((f"feat_{name}", pa.float32()) for name in PROPOSAL_FEATURES),  # the state's are derived
     ]
 )
 STEP_SCHEMA = pa.schema(
@@ -272,7 +272,7 @@ def label_tables(
             "p": None if x.is_gt else x.p,
             "completions": x.completions,
             "is_gt": x.is_gt,
-            **{f"feat_{name}": float(v) for name, v in zip(FEATURES, st.features[j], strict=True)},
+            **{f"feat_{name}": float(v) for name, v in zip(PROPOSAL_FEATURES, st.features[j], strict=False)},
         }
         for st in steps
         for j, x in enumerate(st.proposals)
