@@ -180,6 +180,12 @@ def measure_warm(cmd: list[str], warm: Warm, timeout: float) -> Run:
     return Run(caller.rc, caller.cpu_s + call["cpu_s"], caller.wall_s, peak, caller.tail)
 
 
+def _warm_out(cmd: list[str]) -> list[str]:
+    """``cmd`` writing to its own ``--out`` folder (``<out>_warm``)."""
+    at = cmd.index("--out") + 1
+    return [*cmd[:at], f"{cmd[at]}_warm", *cmd[at + 1 :]]
+
+
 def run_part(step: Path, work: Path, args: argparse.Namespace, original_ok: bool, warm: Warm | None) -> dict:
     env = {**os.environ, "PYTHONPATH": str(ROOT), "ZONEGRAPH_NO_SERVER": "1"}
     cli = [sys.executable, "-m", "zonegraph"]  # as the console script
@@ -189,7 +195,7 @@ def run_part(step: Path, work: Path, args: argparse.Namespace, original_ok: bool
         budget = ["--budget", str(args.budget), "--guide", args.guide]
         runs["infer"] = cli + ["infer", str(step), "--out", str(work / f"{step.stem}_infer"), *budget]
     if warm is not None:
-        runs |= {f"{name} warm": [*cmd[:-1], f"{cmd[-1]}_warm"] for name, cmd in list(runs.items())}
+        runs |= {f"{name} warm": _warm_out(cmd) for name, cmd in list(runs.items())}
     if original_ok:
         src = args.original / "src"
         code = ORIGINAL_DRIVER.format(src=str(src), paths=original_paths(args), step=str(step))

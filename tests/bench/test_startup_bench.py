@@ -8,7 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from bench.startup_bench import original_problem, table
+from bench.startup_bench import _warm_out, original_problem, table
 
 MEASURE = """
 import json, sys
@@ -43,3 +43,8 @@ def test_the_original_is_skipped_with_a_reason_and_the_table_has_medians(tmp_pat
     rows = [{"part": p, "step_bytes": n, "build": run} for p, n in (("a", 10), ("b", 5))]
     text = table(rows, ["build"], "because")
     assert "| **median of 2** | 1.00 | 2.00 | 250 |" in text and "smallest part (b" in text
+
+
+def test_a_warm_run_writes_to_its_own_out_folder_whatever_follows_it():
+    cmd = ["python", "-m", "zonegraph", "infer", "p.step", "--out", "o/p", "--budget", "1", "--guide", "net"]
+    assert _warm_out(cmd) == [*cmd[:6], "o/p_warm", *cmd[7:]]
