@@ -198,8 +198,10 @@ def test_the_shipped_weights_are_read_on_the_first_state_the_network_scores(stat
 def test_a_folded_scorer_missing_its_arrays_is_refused_when_opened(tmp_path):
     path = tmp_path / "cut.npz"
     with np.load(SHIPPED_FOLDED) as data:
-        kept = {k: data[k] for k in data.files if not k.startswith("rounds.")}
-    np.savez(path, **kept)
+        kept = {k: data[k] for k in data.files}
+    meta = json.loads(str(kept["meta"]))
+    meta["arrays"] = {k: v for k, v in meta["arrays"].items() if not k.startswith("rounds.")}
+    np.savez(path, **kept | {"meta": np.array(json.dumps(meta))})
     with pytest.raises(ValueError, match="cut.npz: a folded scorer without the arrays of rounds"):
         NetworkRanker(path)
     (tmp_path / "text.npz").write_text("not a zip")
@@ -219,3 +221,26 @@ def test_the_training_projects_are_kept_beside_a_small_header(tmp_path):
     arrays["meta"] = np.array(json.dumps(meta))
     np.savez(tmp_path / "older.npz", **arrays)
     assert FoldedScorer.load(tmp_path / "older.npz").train_projects == shipped.train_projects
+
+
+def test_the_layers_are_one_member_and_files_of_one_member_per_array_still_load(tmp_path):
+    """A guide reads the weights while it searches: one flat member instead of one per array
+    (a zip lookup and a header parse each). Files saved before keep loading to the same scorer."""
+    shipped = FoldedScorer.load(SHIPPED_FOLDED)
+    with np.load(SHIPPED_FOLDED) as data:
+        assert set(data.files) == {"meta", "weights", "train_projects"}
+        meta = json.loads(str(data["meta"]))
+        weights, projects = data["weights"], data["train_projects"]
+    per_array = {}
+    for name, (offset, shape) in meta.pop("arrays").items():
+        per_array[name] = weights[offset : offset + int(np.prod(shape))].reshape(shape)
+    np.savez(tmp_path / "older.npz", meta=np.array(json.dumps(meta)), train_projects=projects, **per_array)
+    older = FoldedScorer.load(tmp_path / "older.npz")
+    for a, b in zip(_layers(shipped), _layers(older), strict=True):
+        assert np.array_equal(a.weight, b.weight) and np.array_equal(a.bias, b.bias)
+    assert older.train_projects == shipped.train_projects
+    assert FoldedScorer.load(SHIPPED_FOLDED, projects=False).train_projects == ()
+
+
+def _layers(scorer: FoldedScorer) -> list:
+    return [layer for chains in scorer._chains().values() for chain in chains for layer in chain]

@@ -53,6 +53,20 @@ class Affine:
 Chain = tuple[Affine, ...]
 
 
+def _arrays(data: Any, meta: dict[str, Any]) -> Any:
+    """An array of a saved scorer by name: a slice of the one ``weights`` member, or (files saved
+    before it) a member of its own."""
+    if "arrays" not in meta:
+        return lambda name: data[name]
+    weights = data["weights"]
+
+    def array(name: str) -> np.ndarray:
+        offset, shape = meta["arrays"][name]
+        return weights[offset : offset + int(np.prod(shape))].reshape(shape)
+
+    return array
+
+
 def run(chain: Chain, x: np.ndarray) -> np.ndarray:
     """The chain's layers applied in order."""
     for layer in chain:
@@ -157,26 +171,37 @@ class FoldedScorer:
         return [np.concatenate([np.ones((1, z), bool), m]) for m in reach]
 
     def save(self, path: str | Path) -> None:
-        """Writes the arrays and the configuration as one ``.npz`` (no pickled objects)."""
-        arrays: dict[str, np.ndarray] = {}
+        """Writes the configuration and every layer's arrays as one ``.npz`` (no pickled objects):
+        the layers in one flat member (``weights``, each array's offset and shape in the header),
+        since a guide reads them while it searches and a member costs a zip lookup and a header
+        parse (34 members: 5 ms of a search of 30 ms; one: 0.5 ms)."""
+        flat: list[np.ndarray] = []
+        places: dict[str, list[Any]] = {}
         layout: dict[str, list[list[bool]]] = {}
+        offset = 0
         for name, chains in self._chains().items():
             layout[name] = []
             for c, chain in enumerate(chains):
                 layout[name].append([layer.activation for layer in chain])
                 for i, layer in enumerate(chain):
-                    arrays[f"{name}.{c}.{i}.weight"] = layer.weight
-                    arrays[f"{name}.{c}.{i}.bias"] = layer.bias
+                    for part, array in (("weight", layer.weight), ("bias", layer.bias)):
+                        places[f"{name}.{c}.{i}.{part}"] = [offset, list(array.shape)]
+                        flat.append(np.asarray(array, np.float32).ravel())
+                        offset += array.size
         meta = {
             "config": self.config,
             "columns": list(self.columns),
             "layout": layout,
+            "arrays": places,
             "points_per_zone": self.points_per_zone,
             "search": self.search,
         }
-        arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
-        arrays["train_projects"] = np.array(self.train_projects, dtype=str)
-        np.savez(path, **arrays)  # type: ignore[arg-type]
+        np.savez(
+            path,
+            meta=np.array(json.dumps(meta, sort_keys=True)),
+            weights=np.concatenate(flat) if flat else np.zeros(0, np.float32),
+            train_projects=np.array(self.train_projects, dtype=str),
+        )
 
     @staticmethod
     def header(path: str | Path) -> dict[str, Any]:
@@ -198,23 +223,26 @@ class FoldedScorer:
             ]
         except (OSError, KeyError, TypeError, ValueError) as e:
             raise ValueError(f"{path}: not a folded scorer ({e})") from e
+        names |= set(meta.get("arrays", {}))  # one flat member, or (older files) one per array
         missing = [layer for layer in layers if not {f"{layer}.weight", f"{layer}.bias"} <= names]
         if missing:
             raise ValueError(f"{path}: a folded scorer without the arrays of {', '.join(missing[:3])}")
         return meta
 
     @classmethod
-    def load(cls, path: str | Path) -> FoldedScorer:
-        """The scorer `save` wrote."""
+    def load(cls, path: str | Path, projects: bool = True) -> FoldedScorer:
+        """The scorer `save` wrote; ``projects`` False leaves its training projects unread (a
+        guide never needs them, and 2,000 names cost more than the weights)."""
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
+            array = _arrays(data, meta)
             # their own member, so that a guide reads a small header (older files: in the header)
             own = "train_projects" in data.files
-            projects = data["train_projects"] if own else meta.get("train_projects", ())
+            names = (data["train_projects"] if own else meta.get("train_projects", ())) if projects else ()
             chains = {
                 name: tuple(
                     tuple(
-                        Affine(data[f"{name}.{c}.{i}.weight"], data[f"{name}.{c}.{i}.bias"], bool(act))
+                        Affine(array(f"{name}.{c}.{i}.weight"), array(f"{name}.{c}.{i}.bias"), bool(act))
                         for i, act in enumerate(acts)
                     )
                     for c, acts in enumerate(layout)
@@ -232,7 +260,7 @@ class FoldedScorer:
             features=chains["features"][0] if chains["features"] else (),
             points_per_zone=meta["points_per_zone"],
             search=meta["search"],
-            train_projects=tuple(str(p) for p in projects),
+            train_projects=tuple(str(p) for p in names),
         )
 
     def _chains(self) -> dict[str, tuple[Chain, ...]]:

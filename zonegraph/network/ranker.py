@@ -125,7 +125,7 @@ class LazyScorer:
         features: np.ndarray | None,
     ) -> np.ndarray:
         if self._scorer is None:
-            self._scorer = NumpyScorer(FoldedScorer.load(self.path))
+            self._scorer = NumpyScorer(FoldedScorer.load(self.path, projects=False))
         return self._scorer.score(graph, canvas, zones, ops, features)
 
 
