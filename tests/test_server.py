@@ -166,3 +166,22 @@ def test_status_and_stop_without_a_server(tmp_path: Path) -> None:
     assert status.returncode == 1 and "none of this code runs" in status.stdout
     stop = _zonegraph(folder, "server", "stop")
     assert stop.returncode == 0 and "nothing to stop" in stop.stdout
+
+
+def test_stop_also_stops_a_server_of_other_code(tmp_path: Path) -> None:
+    """A server left from an older install answers on another socket name in the same folder:
+    status says it runs, and stop stops it too instead of leaving it to idle out."""
+    folder = Path(tempfile.mkdtemp(prefix="zgs")) / "mixed"
+    try:
+        folder.mkdir(mode=0o700)
+        older = folder / "0123456789abcdef.sock"
+        serve = [sys.executable, "-m", "zonegraph.server", str(older), "60"]
+        proc = subprocess.Popen(serve, env=_env(folder))
+        assert _wait(lambda: older.exists(), 120.0)
+        status = _zonegraph(folder, "server", "status")
+        assert status.returncode == 1 and "1 of other code still running" in status.stdout
+        stop = _zonegraph(folder, "server", "stop")
+        assert stop.returncode == 0 and "1 of other code stopped" in stop.stdout
+        assert proc.wait(timeout=30) == 0 and not older.exists()
+    finally:
+        shutil.rmtree(folder.parent, ignore_errors=True)

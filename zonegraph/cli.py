@@ -510,16 +510,18 @@ def _add_server(sub: Any) -> None:
 def _cmd_server(args: argparse.Namespace) -> int:
     from zonegraph import server
 
-    actions = {"start": lambda: server.start(args.idle * 60), "stop": server.stop, "status": server.status}
+    state: dict[str, Any] | None
     try:
-        state = actions[args.action]()
+        if args.action == "start":
+            state, other = server.start(args.idle * 60), 0
+        elif args.action == "stop":
+            state, other = server.stop()
+        else:
+            state, other = server.status(), len(server.others())
     except server.ServerError as exc:
         print(f"zonegraph: error: {exc}", file=sys.stderr)
         return EXIT_USER_ERROR
-    if args.json:
-        print(json.dumps(state))
-    else:
-        print(server.describe(args.action, state))
+    print(json.dumps(state) if args.json else server.describe(args.action, state, other))
     return 0 if state is not None or args.action != "status" else 1
 
 

@@ -380,23 +380,44 @@ def status() -> dict[str, Any] | None:
     return ask("status")
 
 
-def describe(action: str, state: dict[str, Any] | None) -> str:
-    """What ``zonegraph server ACTION`` prints."""
+def others() -> list[str]:
+    """The sockets of this user's servers of other code (an older install, say) that answer."""
+    folder, own = directory(), socket_path()
+    names = sorted(os.listdir(folder)) if os.path.isdir(folder) else []
+    paths = [os.path.join(folder, n) for n in names if n.endswith(".sock")]
+    return [p for p in paths if p != own and ask("status", p) is not None]
+
+
+def describe(action: str, state: dict[str, Any] | None, other: int = 0) -> str:
+    """What ``zonegraph server ACTION`` prints; ``other``: servers of other code running (status)
+    or stopped (stop)."""
+    if action == "stop" and other:
+        tail = f"; {other} of other code stopped"
+    elif other:
+        tail = f"; {other} of other code still running (zonegraph server stop stops them)"
+    else:
+        tail = ""
     if state is None:
-        return "zonegraph server: none of this code runs" + (" (nothing to stop)" if action == "stop" else "")
+        nothing = " (nothing to stop)" if action == "stop" and not other else ""
+        return f"zonegraph server: none of this code runs{nothing}{tail}"
     what = {"start": "already running" if state.get("already") else "started", "stop": "stopped"}
     head = f"zonegraph server: {what.get(action, 'running')}, pid {state['pid']}"
     if action == "start":
         return f"{head}, socket {state['socket']}; calls now skip the start-up (zonegraph server stop)"
     return (
         f"{head}, up {state['uptime_s']:.0f} s, {state['served']} calls served "
-        f"({state['children_cpu_s']:.2f} CPU s), {state['running']} running, {state['peak_mb']:.0f} MB"
+        f"({state['children_cpu_s']:.2f} CPU s), {state['running']} running, {state['peak_mb']:.0f} MB{tail}"
     )
 
 
-def stop() -> dict[str, Any] | None:
-    """Stop the server of this code; its last status, or None where none ran."""
-    path = socket_path()
+def stop() -> tuple[dict[str, Any] | None, int]:
+    """Stop this user's servers: this code's (its last status, or None where none ran) and any of
+    other code (how many), which would otherwise idle until their time is up."""
+    stopped = [answer for path in others() if (answer := _stop_one(path)) is not None]
+    return _stop_one(socket_path()), len(stopped)
+
+
+def _stop_one(path: str) -> dict[str, Any] | None:
     answer = ask("stop", path)
     if answer is None:
         return None
