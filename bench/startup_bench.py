@@ -156,11 +156,10 @@ def start_server(work: Path) -> tuple[Warm, dict]:
     """A server in a private folder of ``work``; its start measured: the starting command's own
     process, and the server's CPU and memory once it answers."""
     folder = work / "servers"
-    warm = Warm(folder, "")
     cmd = [sys.executable, "-m", "zonegraph.cli", "server", "start", "--json"]
     with tempfile.TemporaryFile() as out:
         t0 = time.perf_counter()
-        subprocess.run(cmd, cwd=ROOT, env=warm.env(), stdout=out, check=True)
+        subprocess.run(cmd, cwd=ROOT, env=Warm(folder, "").env(), stdout=out, check=True)
         wall = time.perf_counter() - t0
         out.seek(0)
         state = json.loads(out.read())

@@ -70,17 +70,20 @@ def private(folder: Path) -> Path:
     return folder
 
 
-# The serving side --------------------------------------------------------------------------------
-
-
 @dataclass
 class _Calls:
-    """The server's calls in flight (child pid -> its caller's connection) and its tally."""
+    """The server's calls in flight (child pid -> its caller's connection), its tally, and
+    whether it is stopping (asked to, or its socket file is gone)."""
 
     running: dict[int, socket.socket] = field(default_factory=dict)
     served: int = 0
     last: float = field(default_factory=time.monotonic)
     ended: dict[str, Any] | None = None  # the last call's exit status, CPU seconds and peak memory
+    started: float = field(default_factory=time.time)
+    stopping: bool = False
+
+    def stop(self, *_signal: object) -> None:
+        self.stopping = True
 
 
 def warm() -> None:
@@ -114,19 +117,17 @@ def serve(path: Path, idle_s: float = IDLE_S) -> None:
     os.set_blocking(wake_write, False)
     signal.set_wakeup_fd(wake_write)
     signal.signal(signal.SIGCHLD, lambda *_: None)
-    stopping: list[bool] = []
-    signal.signal(signal.SIGTERM, lambda *_: stopping.append(True))
     calls = _Calls()
+    signal.signal(signal.SIGTERM, calls.stop)
     selector = selectors.DefaultSelector()
     selector.register(listener, selectors.EVENT_READ, "accept")
     selector.register(wake_read, selectors.EVENT_READ, "wake")
-    started = time.time()
     try:
-        while calls.running or not (stopping or time.monotonic() - calls.last >= idle_s):
+        while calls.running or not (calls.stopping or time.monotonic() - calls.last >= idle_s):
             for key, _ in selector.select(timeout=1.0):
                 try:
                     if key.data == "accept":
-                        _accept(listener, selector, calls, started, stopping, (wake_read, wake_write))
+                        _accept(listener, selector, calls, (wake_read, wake_write))
                     elif key.data == "wake":
                         _drain(wake_read)
                     else:
@@ -134,9 +135,9 @@ def serve(path: Path, idle_s: float = IDLE_S) -> None:
                 except Exception:  # one caller's broken connection must not end the others' server
                     traceback.print_exc()
             _reap(selector, calls)
-            if not stopping and not _owns(path, inode):  # removed or replaced: no caller can reach it
-                stopping.append(True)
-            if stopping and listener.fileno() in selector.get_map():
+            if not _owns(path, inode):  # removed or replaced: no caller can reach it
+                calls.stop()
+            if calls.stopping and listener.fileno() in selector.get_map():
                 selector.unregister(listener)  # no new call; those running end first
                 _unlink_own(path, inode)
     finally:
@@ -163,8 +164,6 @@ def _accept(
     listener: socket.socket,
     selector: selectors.BaseSelector,
     calls: _Calls,
-    started: float,
-    stopping: list[bool],
     wake: tuple[int, int],
 ) -> None:
     conn, _ = listener.accept()
@@ -190,8 +189,8 @@ def _accept(
     for fd in fds:
         os.close(fd)
     if request.get("op") == "stop":
-        stopping.append(True)
-    send(conn, _status(calls, started))
+        calls.stop()
+    send(conn, _status(calls))
     conn.close()
 
 
@@ -203,14 +202,14 @@ def _same_user(conn: socket.socket) -> bool:
     return struct.unpack("3i", creds)[1] == os.getuid()
 
 
-def _status(calls: _Calls, started: float) -> dict[str, Any]:
+def _status(calls: _Calls) -> dict[str, Any]:
     import resource
 
     own = resource.getrusage(resource.RUSAGE_SELF)
     children = resource.getrusage(resource.RUSAGE_CHILDREN)
     return {
         "pid": os.getpid(),
-        "uptime_s": time.time() - started,
+        "uptime_s": time.time() - calls.started,
         "served": calls.served,
         "running": len(calls.running),
         "cpu_s": own.ru_utime + own.ru_stime,
@@ -340,9 +339,6 @@ def _stream(fd: int) -> Any:
     mode = "r" if fd == 0 else "w"
     line = 1 if fd and os.isatty(fd) else -1
     return os.fdopen(fd, mode, buffering=line, encoding="utf-8", errors="replace", closefd=False)
-
-
-# Starting and stopping ---------------------------------------------------------------------------
 
 
 def start(idle_s: float = IDLE_S) -> dict[str, Any]:

@@ -257,6 +257,7 @@ def label_tables(
     """The labels of one design as the ``(proposals, steps)`` tables of `PROPOSAL_SCHEMA`
     and `STEP_SCHEMA`: plain Parquet columns, readable without this package."""
     n = len(gt)
+    stored = [f"feat_{name}" for name in PROPOSAL_FEATURES]  # the state's are derived on reading
     proposals = [
         {
             "design_id": design_id,
@@ -272,7 +273,7 @@ def label_tables(
             "p": None if x.is_gt else x.p,
             "completions": x.completions,
             "is_gt": x.is_gt,
-            **{f"feat_{name}": float(v) for name, v in zip(PROPOSAL_FEATURES, st.features[j], strict=False)},
+            **dict(zip(stored, map(float, st.features[j, : len(stored)]), strict=True)),
         }
         for st in steps
         for j, x in enumerate(st.proposals)
