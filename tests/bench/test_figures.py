@@ -128,20 +128,62 @@ def test_the_fault_figure_totals_the_benchs_tallies_and_names_failed_trials(tmp_
     assert "- trial 4: a record differs" in table
 
 
-def test_every_results_table_is_drawn_from_a_figure_or_marked_as_typed():
-    """A hand-typed table without its source is kept only with the commit that added it."""
+TYPED_MARKER = re.compile(r"<!--\s*typed:")
+NUMBER_CELL = re.compile(r"[*]*[\d.,]+%?[*]*(\s.*)?")
+SEPARATOR_ROW = re.compile(r"\|(\s*:?-+:?\s*\|)+")
+
+
+def _numeric_tables(text: str) -> list[tuple[str, str]]:
+    """Each Markdown table of ``text`` with a number in its body, with the block that follows it."""
+    blocks = text.split("\n\n")
+    tables = []
+    for i, block in enumerate(blocks):
+        rows = [line.strip() for line in block.split("\n") if line.strip().startswith("|")]
+        if len(rows) < 2 or not SEPARATOR_ROW.fullmatch(rows[1]):
+            continue
+        cells = [c.strip() for row in rows[2:] for c in row.strip("|").split("|")]
+        if any(NUMBER_CELL.fullmatch(c) for c in cells):
+            tables.append((block, blocks[i + 1] if i + 1 < len(blocks) else ""))
+    return tables
+
+
+def test_the_table_finder_sees_a_numeric_table_and_nothing_else():
+    words = "Text | with a bar.\n\n| page | what |\n|---|---|\n| a | b |"
+    numbers = "Note:\n| n | s |\n|---:|---|\n| 3 | 1.5 s |"
+    (table, after), *rest = _numeric_tables(f"{words}\n\n{numbers}\n\n<!-- typed: abc1234 -->")
+    assert not rest and table.startswith("Note:") and after == "<!-- typed: abc1234 -->"
+
+
+def test_results_pages_draw_every_table_from_a_figure():
+    """A results page holds no number typed by hand: every table is a ``<!-- figure: -->`` marker
+    that the hook draws from ``docs/figures/``; a number typed before its results file was kept is
+    history, in the changelog."""
+    pages = sorted((ROOT / "docs/results").glob("*.md"))
+    assert pages
+    for page in pages:
+        text = page.read_text()
+        assert not TYPED_MARKER.search(text), f"{page.name}: a typed number belongs in docs/CHANGELOG.md"
+        tables = _numeric_tables(text)
+        assert not tables, f"{page.name}: a table typed by hand, not a figure: {tables[0][0][:80]}"
+
+
+def test_the_front_pages_quote_no_typed_number():
+    """The README's and the site's headline tables are drawn by ``python -m bench.readme``."""
+    for page in (ROOT / "README.md", ROOT / "docs/index.md"):
+        assert not TYPED_MARKER.search(page.read_text()), f"{page.name} quotes a typed number"
+
+
+def test_the_changelog_keeps_the_commit_that_added_each_typed_table():
+    """History keeps a table typed from a command's output with the commit that added it, which
+    the hook renders as a note under the table."""
     hook = _hook()
     assert "when 92348d7 added it" in hook.render("<!-- typed: 92348d7 -->")
-    for page in (ROOT / "docs/results").glob("*.md"):
-        blocks = page.read_text().split("\n\n")
-        for i, block in enumerate(blocks):
-            cells = [c.strip() for c in block.split("|---", 1)[-1].split("|")]
-            numbers = [c for c in cells if re.fullmatch(r"[*]*[\d.,]+%?[*]*(\s.*)?", c)]
-            if block.lstrip().startswith("|") and "|---" in block and numbers:
-                after = blocks[i + 1] if i + 1 < len(blocks) else ""
-                assert after.startswith("<!-- typed:"), (
-                    f"{page.name}: a typed table without its commit: {block[:80]}"
-                )
+    tables = _numeric_tables((ROOT / "docs/CHANGELOG.md").read_text())
+    assert tables
+    for table, after in tables:
+        assert hook.TYPED.fullmatch(after.strip()), (
+            f"CHANGELOG.md: a typed table without the commit that added it: {table[:80]}"
+        )
 
 
 def test_build_search_and_replay_figures_come_from_the_benches_rows():
