@@ -439,6 +439,11 @@ def startup_figure(results: Path) -> dict:
     }
 
 
+def cover_figure(results: Path) -> dict:
+    """The cover benchmark's counts (``tally.json`` beside its ``results.json``)."""
+    return json.loads((results.parent / "tally.json").read_text())
+
+
 FIGURES_OF = {
     "build": build_figure,
     "search": search_figure,
@@ -479,7 +484,9 @@ def write_figure(
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("kind", choices=[*FIGURES_OF, "fusion-diff", "report", "pipeline-run", "startup"])
+    ap.add_argument(
+        "kind", choices=[*FIGURES_OF, "fusion-diff", "report", "pipeline-run", "startup", "cover"]
+    )
     ap.add_argument("name", help="the figure's file name under --out, without .json")
     ap.add_argument("results", type=Path, help="the benchmark's results.json (a project, for pipeline-run)")
     ap.add_argument("--command", required=True, help="the command that wrote RESULTS")
@@ -493,6 +500,8 @@ def main() -> None:
         figure = pipeline_run_figure(args.results)
     elif args.kind == "startup":
         figure = startup_figure(args.results)
+    elif args.kind == "cover":
+        figure = cover_figure(args.results)
     else:
         coverage = args.kind == "coverage"
         data = pd.read_parquet(args.results) if coverage else json.loads(args.results.read_text())

@@ -493,6 +493,26 @@ def startup(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def cover(records: list[dict]) -> str:
+    """The fuse ladder's rungs by box cover and checks, and what the cover screen decided, one
+    sample per figure."""
+    lines = ["| sample | designs | covered: checks pass / refuse | uncovered: checks pass / refuse |"]
+    lines.append("|---|---|---|---|")
+    notes = []
+    for r in records:
+        f = r["figure"]
+        agree = f["agree"]
+        cells = [f"{agree[c]['pass']} / {agree[c]['refuse']}" for c in ("covered", "uncovered")]
+        lines.append(_row(r["name"], [str(f["designs"] - sum(f["not_measured"].values())), *cells]))
+        notes.append(
+            f"- {r['name']}: a graph other than the first that passes the checks: "
+            f"{len(f['other_graph'])}; the kept fuse uncovered (the later fuses paid first): "
+            f"{len(f['kept_uncovered'])} {', '.join(f['kept_uncovered'])}; refused fuses set aside "
+            f"before their zones were meshed: {f['skipped']}; not measured: {f['not_measured'] or 0}"
+        )
+    return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
 RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "build": build,
     "search": search,
@@ -510,6 +530,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "heavy": heavy,
     "pipeline-run": pipeline_run,
     "startup": startup,
+    "cover": cover,
 }
 
 
