@@ -50,6 +50,17 @@ def test_zone_mesh_export_opens_with_one_colour_per_side(tmp_path):
     ]
 
 
+def test_the_build_s_own_triangles_export_as_the_solids_meshed_again(tmp_path):
+    """The viewer's file reuses the build's mesh; a graph without it meshes its solids: the same
+    triangles, wound outward either way (the zones tile the 16 cm3 box)."""
+    g = build_zone_graph(Box(4, 4, 1) - Cylinder(1, 1), samples=0)
+    reused = trimesh.load(export_zone_mesh(g, tmp_path / "reused.ply"), process=False)
+    g.zone_mesh = None
+    meshed = trimesh.load(export_zone_mesh(g, tmp_path / "meshed.ply"), process=False)
+    assert len(reused.faces) == len(meshed.faces)
+    assert reused.volume == pytest.approx(16.0, rel=1e-6) and meshed.volume == pytest.approx(16.0, rel=1e-6)
+
+
 def test_samples_are_trimeshs_surface_sampler_draws():
     """The numpy sampler keeps trimesh's draws, so a seed gives the samples it gave with trimesh."""
     from zonegraph.zones.sampling import _surface_samples

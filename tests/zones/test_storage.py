@@ -33,6 +33,8 @@ def test_round_trip_is_equal(samples_dir, tmp_path):
             assert [volume_props(s)[0] for s in a] == pytest.approx(
                 [volume_props(s)[0] for s in b], rel=1e-12
             )
+        elif f.name == "zone_mesh":  # the build's own triangles, for viewers: not saved
+            assert a is not None and b is None
         elif isinstance(a, np.ndarray):
             np.testing.assert_array_equal(a, b)
         else:

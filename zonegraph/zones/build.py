@@ -292,7 +292,7 @@ def build_zone_graph(
         graph.info.update(info, face_loop_rule=rule.value if rule else None)
         break
     if not keep_solids:
-        graph.solids = None
+        graph.solids = graph.zone_mesh = None
     graph.info.update(timer.laps, build_s=round(sum(timer.laps.values()), 4))
     return graph
 
@@ -451,6 +451,7 @@ def _partition(
         **_surface_arrays(surfaces),
         plane_side=mesh.plane_sides(surfaces),
         solids=topo.zones,
+        zone_mesh=mesh.wound(),
     )
     _precise_where_off(graph, topo.zones, region)
     graph.info.update(_mesh_volume_ratios(graph, mesh, solids))
@@ -685,6 +686,15 @@ class _ZoneMesh:
 
     def _zone_triangles(self, zone: TopoDS_Shape) -> Triangles:
         return oriented_triangles(zone, lambda face: self.face_mesh[self.topo.face_map.FindIndex(face) - 1])
+
+    def wound(self) -> list[np.ndarray]:
+        """Each zone's triangle corners wound counter-clockwise seen from outside (a viewer's
+        convention; ``oriented_triangles`` keeps the face's winding and flips the normal)."""
+        out = []
+        for c, n, _ in self.zone_tris:
+            flip = np.einsum("ij,ij->i", np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]), n) < 0
+            out.append(np.where(flip[:, None, None], c[:, ::-1], c))
+        return out
 
     def zone_volumes(self) -> np.ndarray:
         """Each zone's volume from its outward-oriented triangles."""

@@ -73,6 +73,9 @@ class ZoneGraph:
     surface_strip: np.ndarray  # (S,) bool: plane extended as face-loop strips only
     plane_side: np.ndarray  # (S, Z) int8: +1/-1 side of each plane, 0 straddles (or not a plane)
     solids: list | None = None  # zone solids (TopoDS_Solid), in zone order
+    # (T, 3, 3) triangle corners per zone, wound outward: the build's own mesh, kept with the solids for
+    # viewers (``sampling.export_zone_mesh``) so that they need not mesh the zones again; not saved
+    zone_mesh: list | None = None
     info: dict = field(default_factory=dict)  # status, simplified, target faces, timings
 
     def __repr__(self) -> str:

@@ -36,15 +36,36 @@ META_KEY = b"zonegraph"
 ROUND_OFF = 1e-4  # share of the box's volume (zones) or its squared diagonal (faces)
 
 
+def _arrow(values: np.ndarray | list[str]) -> pa.Array:
+    """A column as an Arrow array built from its buffers. ``pa.array`` and ``pa.table`` on numpy
+    arrays first import pandas, to ask whether they were given a Series: 0.3 CPU s and tens of
+    MB in a ``zonegraph build`` process that never uses it."""
+    arr = np.ascontiguousarray(values)
+    if arr.dtype.kind in "US":
+        encoded = [str(v).encode() for v in arr]
+        offsets = np.cumsum([0] + [len(e) for e in encoded], dtype=np.int32)
+        return pa.Array.from_buffers(
+            pa.string(), len(arr), [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(encoded))]
+        )
+    if arr.dtype == bool:
+        bits = np.packbits(arr, bitorder="little")
+        return pa.Array.from_buffers(pa.bool_(), len(arr), [None, pa.py_buffer(bits)])
+    return pa.Array.from_buffers(pa.from_numpy_dtype(arr.dtype), len(arr), [None, pa.py_buffer(arr)])
+
+
 def _fixed(arr: np.ndarray, dtype: DTypeLike | None = None) -> pa.Array:
     """One fixed-width list per row; rows of width 0 (a graph built without surface samples)
     become empty lists, which Arrow's fixed-size lists cannot hold."""
     arr = np.asarray(arr, dtype=dtype)
     width = int(np.prod(arr.shape[1:])) if arr.ndim > 1 else 1
     if width == 0:
-        offsets = pa.array(np.zeros(len(arr) + 1, np.int32))
-        return pa.ListArray.from_arrays(offsets, pa.array([], type=pa.from_numpy_dtype(arr.dtype)))
-    return pa.FixedSizeListArray.from_arrays(pa.array(arr.reshape(-1)), width)
+        offsets = _arrow(np.zeros(len(arr) + 1, np.int32))
+        return pa.ListArray.from_arrays(offsets, _arrow(np.zeros(0, arr.dtype)))
+    return pa.FixedSizeListArray.from_arrays(_arrow(arr.reshape(-1)), width)
+
+
+def _table(columns: dict[str, np.ndarray | pa.Array]) -> pa.Table:
+    return pa.table({k: v if isinstance(v, pa.Array) else _arrow(v) for k, v in columns.items()})
 
 
 def _unfixed(column: pa.ChunkedArray, shape: tuple[int, ...], dtype: DTypeLike = float) -> np.ndarray:
@@ -65,7 +86,7 @@ def save_zone_graph(graph: ZoneGraph, folder: str | Path) -> Path:
         "info": graph.info,
         "samples": int(graph.zone_points.shape[1]),
     }
-    zones = pa.table(
+    zones = _table(
         {
             "volume": graph.zone_volume,
             "centroid": _fixed(graph.zone_centroid),
@@ -76,7 +97,7 @@ def save_zone_graph(graph: ZoneGraph, folder: str | Path) -> Path:
     ).replace_schema_metadata({META_KEY: json.dumps(meta)})
     pq.write_table(zones, folder / "zones.parquet")
     pq.write_table(
-        pa.table(
+        _table(
             {
                 "zone_a": graph.face_zones[:, 0],
                 "zone_b": graph.face_zones[:, 1],
@@ -89,13 +110,13 @@ def save_zone_graph(graph: ZoneGraph, folder: str | Path) -> Path:
         folder / "faces.parquet",
     )
     pq.write_table(
-        pa.table({"face_a": graph.face_links[:, 0], "face_b": graph.face_links[:, 1]}),
+        _table({"face_a": graph.face_links[:, 0], "face_b": graph.face_links[:, 1]}),
         folder / "links.parquet",
     )
     pq.write_table(
-        pa.table(
+        _table(
             {
-                "kind": pa.array(list(graph.surface_kind), pa.string()),
+                "kind": _arrow(list(graph.surface_kind)),
                 "normal": _fixed(graph.surface_normal),
                 "offset": graph.surface_offset,
                 "axis": _fixed(graph.surface_axis),
@@ -108,7 +129,7 @@ def save_zone_graph(graph: ZoneGraph, folder: str | Path) -> Path:
         folder / "surfaces.parquet",
     )
     pq.write_table(
-        pa.table(
+        _table(
             {
                 "points": _fixed(graph.zone_points, np.float16),
                 "normals": _fixed(graph.zone_normals, np.float16),
