@@ -340,8 +340,8 @@ def _checked_partition(
     def checked(split: _Split) -> ZoneGraph:
         graph = _partition(norm, box, region, solids, surfaces, split, samples, seed, timer)
         graph.info.update(fuzzy=split.method[1], partition=split.method[0], attempts=made)
-        if uncovered := len(aside):
-            graph.info["uncovered_fuses"] = uncovered
+        if aside:
+            graph.info["uncovered_fuses"] = len(aside)
         if check:
             graph.check(source)
         return graph
@@ -351,11 +351,9 @@ def _checked_partition(
         try:
             split = _split(box, surfaces, method, source)
             made += 1
+            uncovered = screened and method[0] == "fuse" and abs(_box_cover(split) - 1) > BOX_AREA_RTOL
             timer.lap("fuse_s")
-            if screened and method[0] == "fuse" and abs(_box_cover(split) - 1) > BOX_AREA_RTOL:
-                aside.append(split)
-            else:
-                candidates.append(split)
+            (aside if uncovered else candidates).append(split)
         except ZoneGraphBuildError as exc:
             if exc.status == Status.INVALID_INPUT:
                 raise
