@@ -72,7 +72,8 @@ def _job(args: tuple[CorpusEntry, float, str]) -> dict:
 
 def decisions(rungs: list[dict], rtol: float) -> dict:
     """The rung the build keeps before and with the cover screen (indices into ``rungs`` of one
-    rule), and what the screen did."""
+    rule), and what the screen did. The order is ``zones.build._checked_partition``'s: covered
+    fuses in ladder order, then the uncovered ones, then the other methods."""
     ok = [r["checks"] == "ok" for r in rungs]
     covered = [abs(r.get("cover", 0.0) - 1) <= rtol for r in rungs]
     fuses = [i for i, r in enumerate(rungs) if r["method"][0] == "fuse"]

@@ -493,6 +493,10 @@ def startup(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def _named(items: list[str]) -> str:
+    return f" ({', '.join(items)})" if items else ""
+
+
 def cover(records: list[dict]) -> str:
     """The fuse ladder's rungs by box cover and checks, and what the cover screen decided, one
     sample per figure."""
@@ -507,7 +511,7 @@ def cover(records: list[dict]) -> str:
         notes.append(
             f"- {r['name']}: a graph other than the first that passes the checks: "
             f"{len(f['other_graph'])}; the kept fuse uncovered (the later fuses paid first): "
-            f"{len(f['kept_uncovered'])} {', '.join(f['kept_uncovered'])}; refused fuses set aside "
+            f"{len(f['kept_uncovered'])}{_named(f['kept_uncovered'])}; refused fuses set aside "
             f"before their zones were meshed: {f['skipped']}; not measured: {f['not_measured'] or 0}"
         )
     return "\n".join(lines) + "\n\n" + "\n".join(notes) + "\n\nMeasured by:\n\n" + _sources(records)

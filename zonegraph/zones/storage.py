@@ -38,8 +38,8 @@ ROUND_OFF = 1e-4  # share of the box's volume (zones) or its squared diagonal (f
 
 def _arrow(values: np.ndarray | list[str]) -> pa.Array:
     """A column as an Arrow array built from its buffers. ``pa.array`` and ``pa.table`` on numpy
-    arrays first import pandas, to ask whether they were given a Series: 0.3 CPU s and tens of
-    MB in a ``zonegraph build`` process that never uses it."""
+    arrays first import pandas, to ask whether they were given a Series: 0.3 CPU s (profiled in
+    one ``zonegraph build``) in a process that never uses it."""
     arr = np.ascontiguousarray(values)
     if arr.dtype.kind in "US":
         encoded = [str(v).encode() for v in arr]
