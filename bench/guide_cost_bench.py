@@ -161,7 +161,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))
     args = parser.parse_args()
     guides = [GuideSpec.parse(g) for g in args.guides]
-    models = [g.model for g in guides if g.model]
+    models = [g.checkpoint for g in guides if g.checkpoint]
     designs = chosen_designs(
         args.gt, args.graphs, models, args.designs, args.seed, args.part, args.part_seed, args.exclude
     )

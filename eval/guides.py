@@ -1,6 +1,6 @@
 """Guides named on a command line: ``heuristic``, ``random``, or a network with its search knobs.
 
-``net=PATH@top_m=M,blend=B,margin=D`` is the `NetworkRanker` of
+``net=PATH@top_m=M,blend=B,margin=D,defer=1`` is the `NetworkRanker` of
 the checkpoint at PATH (the shipped scorer when PATH is empty) with those knobs, so the rank
 evaluation and the search benchmarks compare the same network under several settings.
 """
@@ -12,7 +12,7 @@ from pathlib import Path
 
 from zonegraph.sequence.rankers import Ranker, make_ranker
 
-KNOBS = {"top_m": int, "blend": float, "margin": float}  # NetworkRanker's keyword arguments
+KNOBS = {"top_m": int, "blend": float, "margin": float, "defer": int}  # NetworkRanker's keyword arguments
 
 
 @dataclass(frozen=True)
@@ -41,6 +41,16 @@ class GuideSpec:
         short = "shipped" if shipped else path.parent.name or model
         label = f"net:{short}" + (f"@{settings}" if settings else "")
         return cls(label, "net", model or None, knobs)
+
+    @property
+    def checkpoint(self) -> str | None:
+        """The network's weights (the shipped scorer's when no path was given), None for the
+        other guides: an evaluation leaves out the designs of the projects they trained on."""
+        if self.name != "net":
+            return None
+        from zonegraph.network.folded import SHIPPED_FOLDED
+
+        return self.model or str(SHIPPED_FOLDED)
 
     def ranker(self, seed: int) -> Ranker:
         """A fresh ranker of this guide (a network loads its checkpoint)."""

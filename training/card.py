@@ -93,7 +93,9 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
         lines.append(
             f"- search defaults stored with the weights: {knobs} (top_m: only the heuristic's top M "
             "proposals of a state are scored, the rest keep the heuristic's order below them; margin: "
-            "only those within that much of the heuristic's best score, none when one leads alone)"
+            "only those within that much of the heuristic's best score, none when one leads alone; defer: "
+            "the heuristic's first choice of a state is taken unscored, the network orders the others "
+            "when the search backtracks)"
         )
     lines += [
         "",
@@ -126,9 +128,17 @@ def main() -> None:
         default=None,
         help="store: score only those within this of the heuristic's best",
     )
+    parser.add_argument(
+        "--defer",
+        type=int,
+        choices=(0, 1),
+        default=None,
+        help="store: 1 takes the heuristic's first choice unscored, the network orders the others",
+    )
     args = parser.parse_args()
     checkpoint = torch.load(args.checkpoint, map_location="cpu", weights_only=True)
-    knobs = (("top_m", args.top_m), ("blend", args.blend), ("margin", args.margin))
+    defer = None if args.defer is None else bool(args.defer)
+    knobs = (("top_m", args.top_m), ("blend", args.blend), ("margin", args.margin), ("defer", defer))
     search = {k: v for k, v in knobs if v is not None}
     if search:  # the guide's defaults (NetworkRanker reads them), kept with the weights they suit
         checkpoint["search"] = {**checkpoint.get("search", {}), **search}

@@ -26,6 +26,16 @@ def test_a_network_spec_carries_its_knobs_to_the_ranker():
     assert GuideSpec.parse("net=runs/whole/scorer.npz").label == "net:whole"
     with pytest.raises(SystemExit, match="unknown option"):
         GuideSpec.parse("net=x.pt@depth=3")
+    deferring = GuideSpec.parse("net=@defer=1")
+    assert deferring.label == "net:shipped@defer=1" and deferring.ranker(0).defer
+
+
+def test_the_shipped_network_named_without_a_path_holds_out_its_training_projects():
+    """``net`` alone is the shipped scorer, whose training designs a benchmark must not search."""
+    shipped = str(SHIPPED_FOLDED)
+    assert GuideSpec.parse("net").checkpoint == GuideSpec.parse("net=@top_m=2").checkpoint == shipped
+    assert GuideSpec.parse("net=runs/a.npz").checkpoint == "runs/a.npz"
+    assert GuideSpec.parse("heuristic").checkpoint is None
 
 
 def test_rank_guides_take_network_specs_beside_plain_checkpoints():

@@ -178,6 +178,24 @@ def test_top_m_and_margin_leave_the_network_only_the_heuristics_best_proposals(s
 
 
 @requires_samples
+def test_a_deferring_guide_scores_a_state_only_when_the_search_comes_back_for_a_second_choice(states):
+    graph, canvas, proposals = states[0]  # Couch's empty canvas: no proposal completes it
+    heuristic = HeuristicRanker().score(graph, canvas, proposals)
+    ranker = NetworkRanker(defer=True)
+    order = ranker.order_at(graph, canvas, proposals, 0, 5)
+    assert next(order) == int(np.argmax(heuristic))
+    assert not ranker.scorer.loaded, "the heuristic's first choice waited for the network"
+    rest = list(order)
+    assert ranker.scorer.loaded and len(rest) == 4 and int(np.argmax(heuristic)) not in rest
+    scores = NetworkRanker().score_at(graph, canvas, proposals, 0)
+    eager = [i for i in np.argsort(-scores, kind="stable") if i != int(np.argmax(heuristic))]
+    assert rest == eager[:4]  # the others in the network's order, as the guide without defer
+    solved = search(graph, NetworkRanker(defer=True), SearchConfig(budget_s=30.0), ProposalGenerator(graph))
+    plain = search(graph, HeuristicRanker(), SearchConfig(budget_s=30.0), ProposalGenerator(graph))
+    assert solved.exact and [p.key for p in solved.steps] == [p.key for p in plain.steps]
+
+
+@requires_samples
 def test_the_shipped_weights_are_read_on_the_first_state_the_network_scores(states):
     ranker = NetworkRanker()
     assert not ranker.scorer.loaded and ranker.top_m == FoldedScorer.load(SHIPPED_FOLDED).search["top_m"]

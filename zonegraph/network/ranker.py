@@ -15,7 +15,9 @@ heuristic's: ``top_m`` scores only the heuristic's best M proposals of a state w
 (the rest follow, in the heuristic's order, below every scored one), ``margin`` only those whose
 heuristic score is within that much of the best one's (a state where the heuristic's first
 choice leads by more costs no network call at all), and ``blend`` mixes the heuristic's score
-into the network's (``(1 - blend) * net + blend * heuristic``). A checkpoint may carry its own
+into the network's (``(1 - blend) * net + blend * heuristic``), and ``defer`` takes the heuristic's
+first choice of a state unscored and asks the network only when the search comes back for a
+second one (a search that never backtracks costs what the heuristic's does). A checkpoint may carry its own
 defaults (its ``search`` entry); the arguments override them. And a
 proposal that completes the target (its canvas after the step agrees with the target on every
 zone) goes first unscored: it ends the search, whatever a scorer would say of it.
@@ -23,6 +25,7 @@ zone) goes first unscored: it ends the search, whatever a scorer would say of it
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from functools import cache
 from pathlib import Path
 from typing import Any, Protocol
@@ -165,6 +168,7 @@ class NetworkRanker:
         top_m: int | None = None,
         blend: float | None = None,
         margin: float | None = None,
+        defer: bool | None = None,
     ) -> None:
         path = Path(model) if model else SHIPPED_FOLDED
         if not path.is_file():
@@ -175,6 +179,7 @@ class NetworkRanker:
         self.top_m: int | None = top_m if top_m is not None else search.get("top_m")
         self.blend = float(blend if blend is not None else search.get("blend", 0.0))
         self.margin: float | None = margin if margin is not None else search.get("margin")
+        self.defer = bool(defer if defer is not None else search.get("defer", False))
         self._heuristic = HeuristicRanker()
         self._graph: ZoneGraph | None = None
         self._on_target: np.ndarray | None = None
@@ -182,6 +187,27 @@ class NetworkRanker:
     def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
         """(P,) scores of one state whose depth is not known (the step feature reads 0)."""
         return self.score_at(graph, canvas, proposals, 0)
+
+    def order_at(
+        self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int, k: int
+    ) -> Iterator[int]:
+        """At most ``k`` proposals of one state, best first, as the search asks for them: ordered
+        by `score_at`, or with ``defer`` the heuristic's first choice, then (scored only when
+        the search backtracks to this state) the network's order of the others."""
+        if not self.defer:
+            scores = self.score_at(graph, canvas, proposals, step)
+            return iter(np.argsort(-scores, kind="stable")[:k].tolist())
+        first = int(np.argmax(self._heuristic.score(graph, canvas, proposals)))
+        return self._after(first, graph, canvas, proposals, step, k)
+
+    def _after(
+        self, first: int, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int, k: int
+    ) -> Iterator[int]:
+        """``first``, then the network's next ``k - 1``, scored when the search asks for them."""
+        yield first
+        if k > 1 and len(proposals) > 1:
+            scores = self.score_at(graph, canvas, proposals, step)
+            yield from [i for i in np.argsort(-scores, kind="stable").tolist() if i != first][: k - 1]
 
     def score_at(
         self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int

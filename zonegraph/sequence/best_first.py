@@ -22,7 +22,7 @@ import numpy as np
 from zonegraph.configs import Config
 from zonegraph.sequence.deadline import Deadline
 from zonegraph.sequence.proposals import Proposal, ProposalGenerator
-from zonegraph.sequence.rankers import Ranker, score_step, zone_exact, zone_iou
+from zonegraph.sequence.rankers import Ranker, order_step, zone_exact, zone_iou
 from zonegraph.zones.model import ZoneGraph
 
 
@@ -70,7 +70,7 @@ class SearchResult:
     time_to_best_s: float
     trace: list[tuple[float, float]]  # (seconds, best IoU so far)
     proposals_per_state: list[int]
-    expansion_s: list[float]  # seconds per expansion (proposals + scoring)
+    expansion_s: list[float]  # seconds per expansion (proposals + scoring; a deferred scoring not)
     ended: str = "exhausted"  # why it stopped: exact, exhausted (its space), budget or expansions
 
 
@@ -138,14 +138,13 @@ def search(
         used = {p.inverse_key for p in path}
         props = [p for p in gen.proposals(canvas, deadline) if p.key not in used]
         counts.append(len(props))
-        order: list[int] = []
+        order: Iterator[int] = iter(())
         if props and not deadline.passed():  # past it, the search stops: nothing to score for
-            order = _finishing(graph, canvas, target, props)[:1]
-            if not order:
-                scores = score_step(ranker, graph, canvas, props, len(path))
-                order = np.argsort(-scores, kind="stable")[: config.k_at(len(path))].tolist()
+            done = _finishing(graph, canvas, target, props)[:1]
+            k = config.k_at(len(path))
+            order = iter(done) if done else order_step(ranker, graph, canvas, props, len(path), k)
         times.append(time.perf_counter() - start)
-        return iter([props[i] for i in order])
+        return (props[i] for i in order)
 
     stack = [_Frame(empty, [], expand(empty, []))]
     exact = zone_exact(graph, empty, target)

@@ -8,6 +8,7 @@ agrees with the target after the operation, ties broken by volumetric IoU.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -90,6 +91,20 @@ def score_step(
     if score_at is not None:
         return np.asarray(score_at(graph, canvas, proposals, step), float)
     return np.asarray(ranker.score(graph, canvas, proposals), float)
+
+
+def order_step(
+    ranker: Ranker, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int, k: int
+) -> Iterator[int]:
+    """The indices of at most ``k`` proposals of one state, best first, as a search tries them.
+
+    A ranker that can put off work until the search asks for a state's second choice (the network
+    guide scores a state only when the search backtracks to it, with ``defer``) offers ``order_at``;
+    every other ranker's ``k`` best scores are sorted at once (ties keep the generator's order)."""
+    order_at = getattr(ranker, "order_at", None)
+    if order_at is not None:
+        return iter(order_at(graph, canvas, proposals, step, k))
+    return iter(np.argsort(-score_step(ranker, graph, canvas, proposals, step), kind="stable")[:k].tolist())
 
 
 def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
