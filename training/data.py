@@ -49,7 +49,8 @@ class LabelDataset(Dataset):
 
     ``mode="train"`` keeps positives and negatives only (the focal loss ignores neutrals; with
     ``neutrals`` the neutrals too, for a listwise loss that gives them partial credit) and at most
-    ``max_proposals`` of a state's proposals (the positive always, the others seeded);
+    ``max_proposals`` of a state's proposals (the positive always, the others seeded; None: all,
+    as the rank judges a state);
     ``mode="rank"`` keeps every proposal, to rank the GT among all of them.
     """
 
@@ -59,7 +60,7 @@ class LabelDataset(Dataset):
         graphs_dir: str | Path,
         design_ids: Sequence[str] | None = None,
         mode: str = "train",
-        max_proposals: int = 64,
+        max_proposals: int | None = 64,
         points_per_zone: int | None = 128,
         seed: int = 0,
         neutrals: bool = False,
@@ -112,7 +113,7 @@ class LabelDataset(Dataset):
             return np.arange(len(state.labels))
         pos = np.flatnonzero(state.labels == 1)
         neg = np.flatnonzero(state.labels == -1 if not self.neutrals else state.labels != 1)
-        if len(neg) > self.max_proposals - len(pos):
+        if self.max_proposals is not None and len(neg) > self.max_proposals - len(pos):
             rng = np.random.default_rng([self.seed, idx])
             neg = np.sort(rng.choice(neg, self.max_proposals - len(pos), replace=False))
         return np.concatenate([pos, neg])

@@ -85,7 +85,7 @@ class TrainConfig(Config):
     epochs: int = 3
     lr: float = 1e-3
     batch_states: int = 8  # states per batch (each with up to max_proposals proposals)
-    max_proposals: int = 32
+    max_proposals: int | None = 32  # None: every proposal of a state, the set its rank is judged on
     points_per_zone: int = 64
     gamma: float = 0.5
     val_fraction: float = 0.15

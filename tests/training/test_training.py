@@ -110,6 +110,17 @@ def test_both_fusions_score_and_eval_scores_do_not_depend_on_the_batch(labelled)
 
 
 @requires_samples
+def test_a_training_state_keeps_a_seeded_sample_of_its_negatives_or_every_proposal(labelled):
+    every = LabelDataset(labelled / "labels", labelled / "graphs", points_per_zone=16, max_proposals=None)
+    state = max(range(len(every)), key=lambda i: len(every.states[i].labels))
+    negatives = int((every.states[state].labels == -1).sum())
+    assert negatives > 4
+    sampled = LabelDataset(labelled / "labels", labelled / "graphs", points_per_zone=16, max_proposals=4)
+    assert len(sampled.get(state).y) == 4 and int(sampled.get(state).y.sum()) == 1
+    assert len(every.get(state).y) == negatives + 1
+
+
+@requires_samples
 def test_training_reads_only_the_shards_the_labels_records_list_as_ok_and_intact(labelled, tmp_path):
     import shutil
 
