@@ -37,7 +37,7 @@ from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State, zone_s
 from zonegraph.plugins import model_problem
 from zonegraph.sequence.features import proposal_features, target_surfaces
 from zonegraph.sequence.proposals import Op, Proposal
-from zonegraph.sequence.rankers import HeuristicRanker
+from zonegraph.sequence.rankers import HeuristicRanker, best_first
 from zonegraph.zones.model import ZoneGraph
 
 UNSCORED = -3.0  # below any network score (a probability) minus the heuristic's (< 2)
@@ -195,19 +195,26 @@ class NetworkRanker:
         by `score_at`, or with ``defer`` the heuristic's first choice, then (scored only when
         the search backtracks to this state) the network's order of the others."""
         if not self.defer:
-            scores = self.score_at(graph, canvas, proposals, step)
-            return iter(np.argsort(-scores, kind="stable")[:k].tolist())
-        first = int(np.argmax(self._heuristic.score(graph, canvas, proposals)))
-        return self._after(first, graph, canvas, proposals, step, k)
+            return iter(best_first(self.score_at(graph, canvas, proposals, step))[:k])
+        heuristic = self._heuristic.score(graph, canvas, proposals)
+        return self._after(heuristic, graph, canvas, proposals, step, k)
 
     def _after(
-        self, first: int, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int, k: int
+        self,
+        heuristic: np.ndarray,
+        graph: ZoneGraph,
+        canvas: np.ndarray,
+        proposals: list[Proposal],
+        step: int,
+        k: int,
     ) -> Iterator[int]:
-        """``first``, then the network's next ``k - 1``, scored when the search asks for them."""
+        """The heuristic's first choice, then the network's next ``k - 1``, scored when the search
+        asks for them (with the heuristic's scores of the state, computed once)."""
+        first = int(np.argmax(heuristic))
         yield first
         if k > 1 and len(proposals) > 1:
-            scores = self.score_at(graph, canvas, proposals, step)
-            yield from [i for i in np.argsort(-scores, kind="stable").tolist() if i != first][: k - 1]
+            scores = self._scored(heuristic, graph, canvas, proposals, step)
+            yield from [i for i in best_first(scores) if i != first][: k - 1]
 
     def score_at(
         self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int
@@ -217,7 +224,17 @@ class NetworkRanker:
         them all, a proposal that completes the target above them all."""
         if not proposals:
             return np.zeros(0)
-        heuristic = self._heuristic.score(graph, canvas, proposals)
+        return self._scored(self._heuristic.score(graph, canvas, proposals), graph, canvas, proposals, step)
+
+    def _scored(
+        self,
+        heuristic: np.ndarray,
+        graph: ZoneGraph,
+        canvas: np.ndarray,
+        proposals: list[Proposal],
+        step: int,
+    ) -> np.ndarray:
+        """`score_at` given the heuristic's scores of the state's proposals."""
         complete = heuristic >= 1.0  # every zone agrees with the target after the step
         if complete.any():
             return np.where(complete, COMPLETES + heuristic, UNSCORED + heuristic)

@@ -104,7 +104,12 @@ def order_step(
     order_at = getattr(ranker, "order_at", None)
     if order_at is not None:
         return iter(order_at(graph, canvas, proposals, step, k))
-    return iter(np.argsort(-score_step(ranker, graph, canvas, proposals, step), kind="stable")[:k].tolist())
+    return iter(best_first(score_step(ranker, graph, canvas, proposals, step))[:k])
+
+
+def best_first(scores: np.ndarray) -> list[int]:
+    """Indices of ``scores``, highest first; ties keep the generator's order."""
+    return np.argsort(-scores, kind="stable").tolist()
 
 
 def make_ranker(guide: str, seed: int = 0, model: str | None = None) -> Ranker:
