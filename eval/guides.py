@@ -12,7 +12,8 @@ from pathlib import Path
 
 from zonegraph.sequence.rankers import Ranker, make_ranker
 
-KNOBS = {"top_m": int, "blend": float, "margin": float, "defer": int}  # NetworkRanker's keyword arguments
+# NetworkRanker's keyword arguments
+KNOBS = {"top_m": int, "blend": float, "margin": float, "defer": int, "wake": int}
 
 
 @dataclass(frozen=True)

@@ -95,7 +95,8 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
             "proposals of a state are scored, the rest keep the heuristic's order below them; margin: "
             "only those within that much of the heuristic's best score, none when one leads alone; defer: "
             "the heuristic's first choice of a state is taken unscored, the network orders the others "
-            "when the search backtracks)"
+            "when the search backtracks; wake: with defer, the network orders every state of a search "
+            "once it has backtracked)"
         )
     lines += [
         "",
@@ -135,10 +136,23 @@ def main() -> None:
         default=None,
         help="store: 1 takes the heuristic's first choice unscored, the network orders the others",
     )
+    parser.add_argument(
+        "--wake",
+        type=int,
+        choices=(0, 1),
+        default=None,
+        help="store: 1 (with defer) lets the network order every state once the search backtracked",
+    )
     args = parser.parse_args()
     checkpoint = torch.load(args.checkpoint, map_location="cpu", weights_only=True)
-    defer = None if args.defer is None else bool(args.defer)
-    knobs = (("top_m", args.top_m), ("blend", args.blend), ("margin", args.margin), ("defer", defer))
+    defer, wake = (None if flag is None else bool(flag) for flag in (args.defer, args.wake))
+    knobs = (
+        ("top_m", args.top_m),
+        ("blend", args.blend),
+        ("margin", args.margin),
+        ("defer", defer),
+        ("wake", wake),
+    )
     search = {k: v for k, v in knobs if v is not None}
     if search:  # the guide's defaults (NetworkRanker reads them), kept with the weights they suit
         checkpoint["search"] = {**checkpoint.get("search", {}), **search}

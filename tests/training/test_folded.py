@@ -196,6 +196,28 @@ def test_a_deferring_guide_scores_a_state_only_when_the_search_comes_back_for_a_
 
 
 @requires_samples
+def test_a_waking_guide_orders_every_state_by_the_network_once_the_search_backtracked(states):
+    graph, canvas, proposals = states[0]
+    first_choice = int(np.argmax(HeuristicRanker().score(graph, canvas, proposals)))
+    scores = NetworkRanker().score_at(graph, canvas, proposals, 1)
+    eager = [int(i) for i in np.argsort(-scores, kind="stable")]
+    ranker = NetworkRanker(defer=True, wake=True)
+    calls = []
+    scorer_score = ranker.scorer.score
+    ranker.scorer.score = lambda *args: calls.append(1) or scorer_score(*args)  # type: ignore[method-assign]
+    root = ranker.order_at(graph, canvas, proposals, 0, 5)
+    assert next(root) == first_choice
+    assert next(ranker.order_at(graph, canvas, proposals, 1, 5)) == first_choice and not calls, "asleep"
+    next(root)  # the search came back to its first state: it backtracked
+    assert len(calls) == 1
+    awake = ranker.order_at(graph, canvas, proposals, 1, 5)
+    assert next(awake) == eager[0] and len(calls) == 2, "scored before its first choice"
+    assert list(awake) == eager[1:5]
+    again = ranker.order_at(graph, canvas, proposals, 0, 5)
+    assert next(again) == first_choice and len(calls) == 2, "a new search starts asleep"
+
+
+@requires_samples
 def test_the_shipped_weights_are_read_on_the_first_state_the_network_scores(states):
     ranker = NetworkRanker()
     assert not ranker.scorer.loaded and ranker.top_m == FoldedScorer.load(SHIPPED_FOLDED).search["top_m"]

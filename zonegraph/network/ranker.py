@@ -17,7 +17,10 @@ heuristic score is within that much of the best one's (a state where the heurist
 choice leads by more costs no network call at all), and ``blend`` mixes the heuristic's score
 into the network's (``(1 - blend) * net + blend * heuristic``), and ``defer`` takes the heuristic's
 first choice of a state unscored and asks the network only when the search comes back for a
-second one (a search that never backtracks costs what the heuristic's does). A checkpoint may carry its own
+second one (a search that never backtracks costs what the heuristic's does), and ``wake``, with
+``defer``, lets the network order every state of a graph from the first time the search backtracks
+in it on: a design the heuristic's first choices solve costs what the heuristic's search does, one
+where they failed once is searched in the network's order. A checkpoint may carry its own
 defaults (its ``search`` entry); the arguments override them. And a
 proposal that completes the target (its canvas after the step agrees with the target on every
 zone) goes first unscored: it ends the search, whatever a scorer would say of it.
@@ -169,6 +172,7 @@ class NetworkRanker:
         blend: float | None = None,
         margin: float | None = None,
         defer: bool | None = None,
+        wake: bool | None = None,
     ) -> None:
         path = Path(model) if model else SHIPPED_FOLDED
         if not path.is_file():
@@ -180,6 +184,8 @@ class NetworkRanker:
         self.blend = float(blend if blend is not None else search.get("blend", 0.0))
         self.margin: float | None = margin if margin is not None else search.get("margin")
         self.defer = bool(defer if defer is not None else search.get("defer", False))
+        self.wake = bool(wake if wake is not None else search.get("wake", False))
+        self._woken: ZoneGraph | None = None  # the graph in whose search the network took over
         self._heuristic = HeuristicRanker()
         self._graph: ZoneGraph | None = None
         self._on_target: np.ndarray | None = None
@@ -193,8 +199,11 @@ class NetworkRanker:
     ) -> Iterator[int]:
         """At most ``k`` proposals of one state, best first, as the search asks for them: ordered
         by `score_at`, or with ``defer`` the heuristic's first choice, then (scored only when
-        the search backtracks to this state) the network's order of the others."""
-        if not self.defer:
+        the search backtracks to this state) the network's order of the others; with ``wake``
+        every state of a graph is ordered by `score_at` once the search has backtracked in it."""
+        if step == 0:  # a search's first state: a new search, asleep again
+            self._woken = None
+        if not self.defer or self._woken is graph:
             return iter(best_first(self.score_at(graph, canvas, proposals, step))[:k])
         heuristic = self._heuristic.score(graph, canvas, proposals)
         return self._after(heuristic, graph, canvas, proposals, step, k)
@@ -212,6 +221,8 @@ class NetworkRanker:
         asks for them (with the heuristic's scores of the state, computed once)."""
         first = int(np.argmax(heuristic))
         yield first
+        if self.wake:
+            self._woken = graph
         if k > 1 and len(proposals) > 1:
             scores = self._scored(heuristic, graph, canvas, proposals, step)
             yield from [i for i in best_first(scores) if i != first][: k - 1]
