@@ -13,7 +13,7 @@ from zonegraph.data.replay import replay
 from zonegraph.network.checkpoint import SHIPPED, fold, fold_checkpoint, read_checkpoint
 from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer
 from zonegraph.network.model import ModelConfig, ProposalScorer
-from zonegraph.network.ranker import COMPLETES, NetworkRanker, NumpyScorer, open_scorer
+from zonegraph.network.ranker import NetworkRanker, NumpyScorer, open_scorer
 from zonegraph.network.scoring import TorchScorer
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.features import FEATURES, proposal_features
@@ -114,7 +114,10 @@ def test_what_does_not_fold_stays_on_pytorch(tmp_path):
 
 
 @requires_samples
-def test_a_proposal_that_completes_the_target_goes_first_unscored(states):
+def test_a_state_where_a_proposal_completes_the_target_is_ranked_by_the_network_itself(states):
+    """The search takes a completing step without asking a ranker (tests/sequence/test_search.py),
+    so where the guide ranks such a state (the relative GT rank) its order is the network's own,
+    as the paper's: not the heuristic's, which puts every completing proposal first."""
     graph = states[0][0]  # Couch: a box, then a cut
     found = search(graph, HeuristicRanker(), SearchConfig(budget_s=float("inf"), max_expansions=50))
     assert found.exact and len(found.steps) >= 2
@@ -123,10 +126,15 @@ def test_a_proposal_that_completes_the_target_goes_first_unscored(states):
         canvas = step.apply(canvas)
     proposals = ProposalGenerator(graph).proposals(canvas)
     target = graph.zone_inside.astype(bool)
-    finishing = [i for i, p in enumerate(proposals) if np.array_equal(p.apply(canvas), target)]
-    scores = NetworkRanker().score_at(graph, canvas, proposals, len(found.steps) - 1)
-    assert finishing and int(np.argmax(scores)) in finishing
-    assert (scores >= COMPLETES).sum() == len(finishing)
+    assert any(np.array_equal(p.apply(canvas), target) for p in proposals)
+    ranker = NetworkRanker(top_m=0)
+    scores = ranker.score_at(graph, canvas, proposals, len(found.steps) - 1)
+    zones = np.stack([p.zones for p in proposals]).astype(bool)
+    ops = np.array([1 if p.op is Op.UNION else -1 for p in proposals])
+    features = proposal_features(graph, canvas, proposals, len(found.steps) - 1)
+    own = ranker.scorer.score(graph, canvas, zones, ops, features)
+    np.testing.assert_allclose(scores, own, rtol=1e-6)
+    assert np.all((scores >= 0) & (scores <= 1))
 
 
 @requires_samples
@@ -221,15 +229,11 @@ def test_a_waking_guide_orders_every_state_by_the_network_once_the_search_backtr
 def test_the_shipped_weights_are_read_on_the_first_state_the_network_scores(states):
     ranker = NetworkRanker()
     assert not ranker.scorer.loaded and ranker.top_m == FoldedScorer.load(SHIPPED_FOLDED).search["top_m"]
-    graph = states[0][0]  # Couch: the completing cut is taken unscored
+    graph = states[0][0]  # Couch: the heuristic's box, then the completing cut, taken unscored
+    found = search(graph, ranker, SearchConfig(budget_s=30.0), ProposalGenerator(graph))
+    assert found.exact and not ranker.scorer.loaded, "a search that never asked the network read its weights"
     canvas = np.zeros(graph.n_zones, bool)
     proposals = ProposalGenerator(graph).proposals(canvas)
-    box = max(proposals, key=lambda p: HeuristicRanker().score(graph, canvas, [p])[0])
-    after = box.apply(canvas)
-    finishing = ProposalGenerator(graph).proposals(after)
-    assert any(np.array_equal(p.apply(after), graph.zone_inside.astype(bool)) for p in finishing)
-    ranker.score_at(graph, after, finishing, 1)
-    assert not ranker.scorer.loaded, "a state with a completing step read the weights"
     scores = ranker.score_at(graph, canvas, proposals, 0)
     assert ranker.scorer.loaded
     np.testing.assert_array_equal(scores, NetworkRanker().score_at(graph, canvas, proposals, 0))

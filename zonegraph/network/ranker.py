@@ -21,9 +21,10 @@ second one (a search that never backtracks costs what the heuristic's does), and
 ``defer``, lets the network order every state of a graph from the first time the search backtracks
 in it on: a design the heuristic's first choices solve costs what the heuristic's search does, one
 where they failed once is searched in the network's order. A checkpoint may carry its own
-defaults (its ``search`` entry); the arguments override them. And a
-proposal that completes the target (its canvas after the step agrees with the target on every
-zone) goes first unscored: it ends the search, whatever a scorer would say of it.
+defaults (its ``search`` entry); the arguments override them. A state where a proposal completes
+the target never reaches a ranker in search (`zonegraph.sequence.best_first` takes that step
+unscored), so where the guide is asked to rank one (the relative GT rank), the network ranks it
+with its own scores, as the paper's network ranks every state.
 """
 
 from __future__ import annotations
@@ -44,7 +45,6 @@ from zonegraph.sequence.rankers import HeuristicRanker, best_first
 from zonegraph.zones.model import ZoneGraph
 
 UNSCORED = -3.0  # below any network score (a probability) minus the heuristic's (< 2)
-COMPLETES = 2.0  # above any network score, with the heuristic's (< 2) added
 
 
 class StateScorer(Protocol):
@@ -232,7 +232,7 @@ class NetworkRanker:
     ) -> np.ndarray:
         """(P,) scores of every proposal of one state ``step`` operations deep: P(positive), or
         its blend with the heuristic; proposals outside the heuristic's top M or its margin below
-        them all, a proposal that completes the target above them all."""
+        them all."""
         if not proposals:
             return np.zeros(0)
         return self._scored(self._heuristic.score(graph, canvas, proposals), graph, canvas, proposals, step)
@@ -246,9 +246,6 @@ class NetworkRanker:
         step: int,
     ) -> np.ndarray:
         """`score_at` given the heuristic's scores of the state's proposals."""
-        complete = heuristic >= 1.0  # every zone agrees with the target after the step
-        if complete.any():
-            return np.where(complete, COMPLETES + heuristic, UNSCORED + heuristic)
         chosen = np.arange(len(proposals))
         if self.margin is not None:
             chosen = np.flatnonzero(heuristic >= heuristic.max() - self.margin)
