@@ -50,7 +50,9 @@ class LabelDataset(Dataset):
     ``mode="train"`` keeps positives and negatives only (the focal loss ignores neutrals; with
     ``neutrals`` the neutrals too, for a listwise loss that gives them partial credit) and at most
     ``max_proposals`` of a state's proposals (the positive always, the others seeded; None: all,
-    as the rank judges a state);
+    as the rank judges a state), and with ``max_nodes`` at most that many zone copies (proposals
+    times zones): a state of a 16,500-zone graph keeps a few proposals where a small graph's keeps
+    them all, since a batch's memory grows with the copies, not the proposals;
     ``mode="rank"`` keeps every proposal, to rank the GT among all of them.
     """
 
@@ -64,9 +66,11 @@ class LabelDataset(Dataset):
         points_per_zone: int | None = 128,
         seed: int = 0,
         neutrals: bool = False,
+        max_nodes: int | None = None,
     ):
         super().__init__()
         self.mode, self.max_proposals, self.seed, self.neutrals = mode, max_proposals, seed, neutrals
+        self.max_nodes = max_nodes
         shards = label_shards(labels_dir)
         table = ds.dataset(shards.proposals, format="parquet").to_table()
         self.has_features = all(f"feat_{name}" in table.column_names for name in PROPOSAL_FEATURES)
@@ -113,10 +117,19 @@ class LabelDataset(Dataset):
             return np.arange(len(state.labels))
         pos = np.flatnonzero(state.labels == 1)
         neg = np.flatnonzero(state.labels == -1 if not self.neutrals else state.labels != 1)
-        if self.max_proposals is not None and len(neg) > self.max_proposals - len(pos):
+        limit = self._limit(state)
+        if limit is not None and len(neg) > limit - len(pos):
             rng = np.random.default_rng([self.seed, idx])
-            neg = np.sort(rng.choice(neg, self.max_proposals - len(pos), replace=False))
+            neg = np.sort(rng.choice(neg, max(limit - len(pos), 1), replace=False))
         return np.concatenate([pos, neg])
+
+    def _limit(self, state: _State) -> int | None:
+        """The most proposals a training state keeps: ``max_proposals``, fewer where ``max_nodes``
+        zone copies run out first (never fewer than the positives and one other)."""
+        if self.max_nodes is None:
+            return self.max_proposals
+        by_nodes = max(self.max_nodes // max(state.zones.shape[1], 1), int((state.labels == 1).sum()) + 1)
+        return by_nodes if self.max_proposals is None else min(self.max_proposals, by_nodes)
 
     def get(self, idx: int) -> StateData:
         state = self.states[idx]

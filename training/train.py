@@ -86,6 +86,9 @@ class TrainConfig(Config):
     lr: float = 1e-3
     batch_states: int = 8  # states per batch (each with up to max_proposals proposals)
     max_proposals: int | None = 32  # None: every proposal of a state, the set its rank is judged on
+    # zone copies (proposals x zones) per training state at most (None: no bound): 256 proposals of
+    # a 16,500-zone graph are 4.2M copies, and batches of such states exhausted 24 GB
+    max_nodes: int | None = None
     points_per_zone: int = 64
     gamma: float = 0.5
     val_fraction: float = 0.15
@@ -330,9 +333,10 @@ def datasets(config: TrainConfig, train_ids: list[str], val_ids: list[str]) -> d
     common = dict(points_per_zone=config.points_per_zone, seed=config.seed)
     neutrals = config.loss == "listwise" and config.neutral_credit is not None
     args = (config.labels_dir, config.graphs_dir)
+    train = dict(neutrals=neutrals, max_nodes=config.max_nodes, **common)
     sets = {
-        "train": LabelDataset(*args, train_ids, "train", config.max_proposals, neutrals=neutrals, **common),
-        "val": LabelDataset(*args, val_ids, "train", config.max_proposals, neutrals=neutrals, **common),
+        "train": LabelDataset(*args, train_ids, "train", config.max_proposals, **train),
+        "val": LabelDataset(*args, val_ids, "train", config.max_proposals, **train),
         "rank": LabelDataset(*args, val_ids, "rank", **common),
     }
     if config.features and not sets["train"].has_features:

@@ -118,6 +118,11 @@ def test_a_training_state_keeps_a_seeded_sample_of_its_negatives_or_every_propos
     sampled = LabelDataset(labelled / "labels", labelled / "graphs", points_per_zone=16, max_proposals=4)
     assert len(sampled.get(state).y) == 4 and int(sampled.get(state).y.sum()) == 1
     assert len(every.get(state).y) == negatives + 1
+    zones = every.states[state].zones.shape[1]
+    bounded = LabelDataset(
+        labelled / "labels", labelled / "graphs", points_per_zone=16, max_proposals=None, max_nodes=3 * zones
+    )
+    assert len(bounded.get(state).y) == 3 and int(bounded.get(state).y.sum()) == 1  # 3 copies of the graph
 
 
 @requires_samples
