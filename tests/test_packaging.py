@@ -10,6 +10,7 @@ minutes), so these tests are marked slow.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -25,6 +26,9 @@ NOT_SOURCE = {".git", ".venv", ".dvc", "data", "models", "mlruns", "build", "dis
 TORCH_FREE = "import importlib.util as u; print([m for m in ('torch', 'torch_geometric') if u.find_spec(m)])"
 
 pytestmark = pytest.mark.slow
+# The core venv's processes see only what the wheel installed: with a checkout on PYTHONPATH pip
+# would find zonegraph "already installed" there and skip the wheel.
+CORE_ENV = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
 
 
 def _source_copy(dest: Path) -> Path:
@@ -54,7 +58,7 @@ def core_venv(wheel: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     venv = tmp_path_factory.mktemp("core") / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     install = [str(venv / "bin" / "python"), "-m", "pip", "install", "-q", str(wheel)]
-    proc = subprocess.run(install, capture_output=True, text=True)
+    proc = subprocess.run(install, capture_output=True, text=True, env=CORE_ENV)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return venv / "bin"
 
@@ -75,21 +79,26 @@ def test_a_core_install_runs_every_guide_and_names_the_extra_for_a_pytorch_check
     core_venv, samples_dir, tmp_path
 ):
     python, zonegraph = str(core_venv / "python"), str(core_venv / "zonegraph")
-    assert subprocess.run([python, "-c", TORCH_FREE], capture_output=True, text=True).stdout.split() == ["[]"]
+    found = subprocess.run([python, "-c", TORCH_FREE], capture_output=True, text=True, env=CORE_ENV)
+    assert found.stdout.split() == ["[]"]
     guides = "import zonegraph.plugins as p; print(p.available_guides())"
-    listed = subprocess.run([python, "-c", guides], capture_output=True, text=True, check=True, cwd=tmp_path)
+    listed = subprocess.run(
+        [python, "-c", guides], capture_output=True, text=True, check=True, cwd=tmp_path, env=CORE_ENV
+    )
     assert listed.stdout.strip() == "['heuristic', 'random', 'net']"
     part = samples_dir / "Couch.step"
     for guide in ("heuristic", "net"):
         cmd = [zonegraph, "infer", str(part), "--out", str(tmp_path / guide), "--budget", "5"]
         cmd += ["--guide", guide]
-        proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path)
+        proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path, env=CORE_ENV)
         assert proc.returncode == 0, proc.stderr
         assert json.loads((tmp_path / guide / "result.json").read_text())["status"] == "exact"
     checkpoint = tmp_path / "scorer.pt"
     checkpoint.write_bytes(b"not read: torch is missing")
     cmd = [zonegraph, "infer", str(part), "--out", str(tmp_path / "pt"), "--model", str(checkpoint)]
-    proc = subprocess.run([*cmd, "--guide", "net"], capture_output=True, text=True, cwd=tmp_path)
+    proc = subprocess.run(
+        [*cmd, "--guide", "net"], capture_output=True, text=True, cwd=tmp_path, env=CORE_ENV
+    )
     assert proc.returncode == 2
     assert proc.stderr.splitlines() == [
         f"zonegraph: error: {checkpoint}: a PyTorch checkpoint needs torch and torch_geometric: "
