@@ -126,11 +126,8 @@ def write_coverage(
     graph's ground truth was computed; the share of all designs whose GT the first variant
     captures and every variant's categories go to the details. The full graph's variants only
     where the stage built it (``full_graph``): unmeasured, every design would read as a failure."""
-    variants = {
-        f"{graph} graph, level {level}": (graph, level)
-        for graph in ("simplified", "full")[: 2 if full_graph else 1]
-        for level in levels
-    }
+    graphs = ("simplified", "full") if full_graph else ("simplified",)
+    variants = {f"{graph} graph, level {level}": (graph, level) for graph in graphs for level in levels}
     tables = {name: coverage_table(designs, graph, level) for name, (graph, level) in variants.items()}
     (out / "coverage.md").write_text(to_markdown(tables))
     first = next(iter(tables))

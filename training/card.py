@@ -129,30 +129,16 @@ def main() -> None:
         default=None,
         help="store: score only those within this of the heuristic's best",
     )
-    parser.add_argument(
-        "--defer",
-        type=int,
-        choices=(0, 1),
-        default=None,
-        help="store: 1 takes the heuristic's first choice unscored, the network orders the others",
-    )
-    parser.add_argument(
-        "--wake",
-        type=int,
-        choices=(0, 1),
-        default=None,
-        help="store: 1 (with defer) lets the network order every state once the search backtracked",
-    )
+    switches = {
+        "defer": "1 takes the heuristic's first choice unscored, the network orders the others",
+        "wake": "1 (with defer) lets the network order every state once the search backtracked",
+    }
+    for name, text in switches.items():
+        parser.add_argument(f"--{name}", type=int, choices=(0, 1), default=None, help=f"store: {text}")
     args = parser.parse_args()
     checkpoint = torch.load(args.checkpoint, map_location="cpu", weights_only=True)
-    defer, wake = (None if flag is None else bool(flag) for flag in (args.defer, args.wake))
-    knobs = (
-        ("top_m", args.top_m),
-        ("blend", args.blend),
-        ("margin", args.margin),
-        ("defer", defer),
-        ("wake", wake),
-    )
+    flags = {name: None if getattr(args, name) is None else bool(getattr(args, name)) for name in switches}
+    knobs = (("top_m", args.top_m), ("blend", args.blend), ("margin", args.margin), *flags.items())
     search = {k: v for k, v in knobs if v is not None}
     if search:  # the guide's defaults (NetworkRanker reads them), kept with the weights they suit
         checkpoint["search"] = {**checkpoint.get("search", {}), **search}

@@ -117,18 +117,18 @@ class LabelDataset(Dataset):
             return np.arange(len(state.labels))
         pos = np.flatnonzero(state.labels == 1)
         neg = np.flatnonzero(state.labels == -1 if not self.neutrals else state.labels != 1)
-        limit = self._limit(state)
+        limit = self._limit(state.zones.shape[1], len(pos))
         if limit is not None and len(neg) > limit - len(pos):
             rng = np.random.default_rng([self.seed, idx])
-            neg = np.sort(rng.choice(neg, max(limit - len(pos), 1), replace=False))
+            neg = np.sort(rng.choice(neg, limit - len(pos), replace=False))
         return np.concatenate([pos, neg])
 
-    def _limit(self, state: _State) -> int | None:
-        """The most proposals a training state keeps: ``max_proposals``, fewer where ``max_nodes``
-        zone copies run out first (never fewer than the positives and one other)."""
+    def _limit(self, zones: int, positives: int) -> int | None:
+        """The most proposals a training state of ``zones`` zones keeps: ``max_proposals``, fewer
+        where ``max_nodes`` zone copies run out first (never fewer than the positives and one other)."""
         if self.max_nodes is None:
             return self.max_proposals
-        by_nodes = max(self.max_nodes // max(state.zones.shape[1], 1), int((state.labels == 1).sum()) + 1)
+        by_nodes = max(self.max_nodes // max(zones, 1), positives + 1)
         return by_nodes if self.max_proposals is None else min(self.max_proposals, by_nodes)
 
     def get(self, idx: int) -> StateData:
