@@ -25,7 +25,9 @@ the columns meet), of every face on s under the zones swept; a sketch needs all 
 faces' sweeps lie on, and a face that fails rejects the whole sketch. A face inside one zone (a
 face-loop strip or a kept freeform face that ends within the zone: the general fuse leaves it
 dangling, with that zone on both sides) bounds nothing: a sweep passes it and no sketch uses it.
-Sweeps are memoised per (face, s, e): the geometry never changes during search.
+The geometry never changes during search, so sweeps are made once per plane pair, every face
+on its start plane at once (with the pairs after it, in one breadth-first search over (pair,
+zone) nodes), and kept.
 """
 
 from __future__ import annotations
@@ -178,17 +180,76 @@ class _Candidates:
 
 @dataclass(frozen=True)
 class _Slab:
-    """A plane pair's sweep direction and length, the planes' zone sides as lists, and which faces
-    a sweep crosses out of their first and their second zone."""
+    """A plane pair's sweep direction and length, which zones lie between its planes, and which
+    faces a sweep crosses out of their first and their second zone.
+
+    Shapes:
+        inside: (Z + 1,) bool, the last entry (no zone: a face on the box) False; from_a,
+        from_b: (F,) bool.
+    """
 
     d: np.ndarray
     length: float
-    side_s: int
-    side_e: int
-    on_s: list[int]
-    on_e: list[int]
-    from_a: list[bool]
-    from_b: list[bool]
+    inside: np.ndarray
+    from_a: np.ndarray
+    from_b: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Floods:
+    """Every face on one plane pair's start plane swept to its end plane (canvas-independent).
+
+    Shapes:
+        members: (N,) int32, the swept zones of each face in turn (sorted), none for a face whose
+        sweep fails; starts: (F_s + 1,) int64, where each face's zones begin, then the end;
+        fills: (F_s,) int8, `OWN` where the zones fill the face's own prism, `SHARED` where they
+        fill the prism of every face on s under them, 0 where the sweep fails.
+    """
+
+    members: np.ndarray
+    starts: np.ndarray
+    fills: np.ndarray
+
+
+OWN, SHARED = 1, 2
+FLOOD_CELLS = 2**22  # faces x (zones + 1) flooded at once: the visited mask's bytes
+
+
+def _spans(begins: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """The indices ``begins[i] .. begins[i] + counts[i] - 1`` of every i, concatenated."""
+    return np.arange(int(counts.sum())) + np.repeat(begins - (np.cumsum(counts) - counts), counts)
+
+
+def _reached(
+    sources: np.ndarray, targets: np.ndarray, inside: np.ndarray, starts: np.ndarray, width: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """For each of R rows the nodes reached from its start node (-1: none) along the edges
+    ``sources`` -> ``targets``, leaving only nodes that are ``inside``: (row, node % width) pairs
+    (nodes are pair * width + zone), by row, then column. One breadth-first search for all rows:
+    each round expands every row's frontier at once. A (R, width) mask says what was seen; the
+    pairs are collected as they are found (reading them back from the mask scanned all of it,
+    most of a batch's time on graphs of ten thousand zones)."""
+    order = np.argsort(sources, kind="stable")
+    successors = targets[order]
+    bounds = np.concatenate(([0], np.cumsum(np.bincount(sources, minlength=len(inside)))))
+    seen = np.zeros((len(starts), width), bool)
+    rows = np.flatnonzero(starts >= 0)
+    nodes = starts[rows]
+    seen[rows, nodes % width] = True
+    found = [rows * width + nodes % width]
+    while len(rows):
+        go = inside[nodes]
+        rows, nodes = rows[go], nodes[go]
+        counts = bounds[nodes + 1] - bounds[nodes]
+        rows = np.repeat(rows, counts)
+        nodes = successors[_spans(bounds[nodes], counts)]
+        fresh = ~seen[rows, nodes % width]
+        codes, first = np.unique(rows[fresh] * width + nodes[fresh] % width, return_index=True)
+        rows, nodes = rows[fresh][first], nodes[fresh][first]
+        seen[rows, nodes % width] = True
+        found.append(codes)
+    codes = np.sort(np.concatenate(found))
+    return codes // width, codes % width
 
 
 class ProposalGenerator:
@@ -206,10 +267,6 @@ class ProposalGenerator:
         self._local_links = self._local_links_by_plane()
         self._zone_faces = self._faces_of_zones()
         self._sweeps: dict[tuple[int, int, int], Sweep | None] = {}
-        self._face_zone_list = [tuple(pair) for pair in graph.face_zones.tolist()]
-        self._face_surface_list = graph.face_surface.tolist()
-        self._zone_face_lists = [faces.tolist() for faces in self._zone_faces]
-        self._side_lists: dict[int, list[int]] = {}
         self._groups: Memo[_Candidates] = Memo(MEMO_BYTES["groups"], lambda c: c.nbytes)
         self._comps: Memo[list[list[int]]] = Memo(
             MEMO_BYTES["components"], lambda comps: 100 + sum(60 + 8 * len(c) for c in comps)
@@ -220,7 +277,9 @@ class ProposalGenerator:
         self._reach: dict[tuple[int, int], _Reach] = {}
         self._all_reach: _Reach | None = None
         self._slabs: dict[tuple[int, int], _Slab] = {}
+        self._floods: dict[tuple[int, int], _Floods] = {}
         self._beyond = {(s, e): self._zones_beyond(s, e) for s, e in self.pairs}
+        self._pair_index = {pair: i for i, pair in enumerate(self.pairs)}
         self._flatten_pairs()
 
     # ------------------------------------------------------------------ static structure
@@ -304,16 +363,15 @@ class ProposalGenerator:
     # -------------------------------------------------------------------------- sweeping
 
     def sweep(self, face: int, s: int, e: int) -> Sweep | None:
-        """The prism over ``face`` from s to e, or None if its zones do not fill it exactly."""
+        """The prism over ``face`` (a face on s) from s to e, or None if its zones do not fill it
+        exactly."""
         key = (face, s, e)
         if key not in self._sweeps:
             self._sweeps[key] = self._sweep(face, s, e)
         return self._sweeps[key]
 
     def _slab(self, s: int, e: int) -> _Slab:
-        """What every sweep from s to e shares (memoised per pair): a root expansion sweeps
-        hundreds of faces per pair, and computing these per sweep was half of a small sweep's
-        cost."""
+        """What every sweep from s to e shares (memoised per pair)."""
         key = (s, e)
         slab = self._slabs.get(key)
         if slab is None:
@@ -322,79 +380,119 @@ class ProposalGenerator:
             side_s = 1 if float(g.surface_normal[s] @ d) > 0 else -1
             side_e = 1 if float(g.surface_normal[e] @ d) > 0 else -1
             length = float(np.linalg.norm(d))
+            between = (g.plane_side[s] == side_s) & (g.plane_side[e] == -side_e)
             from_a, from_b = self._crossings(d, length)
-            slab = self._slabs[key] = _Slab(
-                d, length, side_s, side_e, self._sides(s), self._sides(e), from_a, from_b
-            )
+            slab = self._slabs[key] = _Slab(d, length, np.append(between, False), from_a, from_b)
         return slab
 
     def _sweep(self, face: int, s: int, e: int) -> Sweep | None:
-        g = self.graph
-        slab = self._slab(s, e)
-        a, b = self._face_zone_list[face]
-        start = b if float(g.face_normal[face] @ slab.d) > 0 else a
-        if start < 0:
+        floods = self._floods_of(s, e, None)
+        assert floods is not None  # no deadline
+        i = int(np.searchsorted(self.faces_on[s], face))
+        fill = int(floods.fills[i])
+        if not fill:
             return None
-        on_s, on_e, side_s, side_e = slab.on_s, slab.on_e, slab.side_s, -slab.side_e
-        crossed_from_a, crossed_from_b = slab.from_a, slab.from_b
-        face_zones, face_surface = self._face_zone_list, self._face_surface_list
-        seen: set[int] = set()
-        stack = [int(start)]
-        while stack:
-            z = stack.pop()
-            if z in seen:
-                continue
-            if on_s[z] != side_s or on_e[z] != side_e:
-                return None  # the zone reaches outside the slab between s and e
-            seen.add(z)
-            for f in self._zone_face_lists[z]:
-                if face_surface[f] == e:
-                    continue
-                fa, fb = face_zones[f]
-                from_first = fa == z
-                if not (crossed_from_a[f] if from_first else crossed_from_b[f]):
-                    continue
-                other = fb if from_first else fa
-                if other < 0:
-                    return None
-                stack.append(other)
-        members = np.sort(np.fromiter(seen, np.int32, len(seen)))  # summed in the zones' order
-        volume = float(g.zone_volume[members].sum())
-        prism = g.face_area[face] * slab.length
-        if abs(volume - prism) <= PRISM_RTOL * prism:
-            return Sweep(members, (face,), g.n_zones)
-        zones = np.zeros(g.n_zones, bool)
+        members = floods.members[floods.starts[i] : floods.starts[i + 1]]
+        if fill == OWN:
+            return Sweep(members, (face,), self.graph.n_zones)
+        zones = np.zeros(self.graph.n_zones, bool)
         zones[members] = True
-        under = self._faces_under(zones, s, e)
-        area = float(g.face_area[under].sum())
-        if face not in under or abs(volume - area * slab.length) > PRISM_RTOL * area * slab.length:
-            return None
-        return Sweep(members, tuple(under), g.n_zones)
+        return Sweep(members, tuple(self._faces_under(zones, s, e)), self.graph.n_zones)
+
+    def _floods_of(self, s: int, e: int, deadline: Deadline | None) -> _Floods | None:
+        """The pair's `_Floods` (memoised), made with the pairs after it that are not made yet
+        as far as `FLOOD_CELLS` allows, or None when ``deadline`` has passed."""
+        floods = self._floods.get((s, e))
+        if floods is None:
+            if deadline is not None and deadline.passed():
+                return None
+            width = self.graph.n_zones + 1
+            batch: list[tuple[int, int]] = []
+            cells = 0
+            for pair in self.pairs[self._pair_index[(s, e)] :]:
+                if pair in self._floods:
+                    continue
+                cells += len(self.faces_on[pair[0]]) * width
+                if batch and cells > FLOOD_CELLS:
+                    break
+                batch.append(pair)
+            self._floods.update(zip(batch, self._flood(batch), strict=True))
+            floods = self._floods[(s, e)]
+        return floods
+
+    def _flood(self, pairs: list[tuple[int, int]]) -> list[_Floods]:
+        """Every face on each pair's start plane swept at once: from the zone beyond the face, on
+        through the faces the sweep crosses (`_crossings`; not those on e) of every zone reached,
+        all faces of all the pairs as one breadth-first search over (pair, zone) nodes. A sweep
+        fails where it reaches a zone outside the slab between s and e, or crosses a face with
+        no zone behind it; else it must fill the face's prism exactly, or the prism of every
+        face on s under its zones.
+
+        One Python walk per face was most of a first expansion on graphs of a thousand zones
+        (37,000 sweeps of 9 zones on average at the root of a 1,544-zone graph)."""
+        g = self.graph
+        width = g.n_zones + 1  # a node per zone, and one for no zone
+        slabs = [self._slab(s, e) for s, e in pairs]
+        first, second = g.face_zones[:, 0], g.face_zones[:, 1]
+        crossable = (g.face_surface[None, :] != np.array([e for _, e in pairs])[:, None]) & (first >= 0)
+        pair_a, out_a = np.nonzero(np.stack([sl.from_a for sl in slabs]) & crossable)  # (B, F) masks
+        pair_b, out_b = np.nonzero(np.stack([sl.from_b for sl in slabs]) & crossable & (second >= 0))
+        behind = np.where(second[out_a] >= 0, second[out_a], g.n_zones)
+        inside = np.concatenate([sl.inside for sl in slabs])
+        faces = np.concatenate([self.faces_on[s] for s, _ in pairs])
+        pair_of_row = np.repeat(np.arange(len(pairs)), [len(self.faces_on[s]) for s, _ in pairs])
+        beyond = np.concatenate([self._beyond[pair] for pair in pairs])
+        starts = np.where(beyond >= 0, beyond + pair_of_row * width, -1)
+        row, zone = _reached(
+            np.concatenate([first[out_a] + pair_a * width, second[out_b] + pair_b * width]),
+            np.concatenate([behind + pair_a * width, first[out_b] + pair_b * width]),
+            inside,
+            starts,
+            width,
+        )
+        on = starts >= 0
+        area_under = np.bincount(starts[on], g.face_area[faces[on]], minlength=len(inside))
+        lengths = np.array([sl.length for sl in slabs])[pair_of_row]
+        node = pair_of_row[row] * width + zone
+        n_rows = len(starts)
+        outside = np.bincount(row, ~inside[node], minlength=n_rows) > 0
+        volume = np.bincount(row, np.append(g.zone_volume, 0.0)[zone], minlength=n_rows)
+        prism = g.face_area[faces] * lengths
+        shared = np.bincount(row, area_under[node], minlength=n_rows) * lengths
+        fills = np.where(
+            np.abs(volume - prism) <= PRISM_RTOL * prism,
+            OWN,
+            np.where(np.abs(volume - shared) <= PRISM_RTOL * shared, SHARED, 0),
+        ).astype(np.int8)
+        fills[outside | ~on] = 0
+        kept = fills[row] > 0
+        bounds = np.concatenate(([0], np.cumsum(np.bincount(row[kept], minlength=n_rows))))
+        members = zone[kept].astype(np.int32)
+        out, lo = [], 0
+        for s, _ in pairs:
+            hi = lo + len(self.faces_on[s])
+            begin, end = bounds[lo], bounds[hi]
+            out.append(_Floods(members[begin:end], bounds[lo : hi + 1] - begin, fills[lo:hi]))
+            lo = hi
+        return out
 
     def _reach_of(self, s: int, e: int, deadline: Deadline | None) -> _Reach | None:
         """The sweep of every face on s whose zone beyond it (towards e) lies outside the target,
-        on the pair (s, e) (memoised), or None when ``deadline`` passes. Only those faces are
-        swept: every face on every pair is most of a many-zone graph's setup, and a face next to
-        a target zone needs none (groups 1-3 place it by that zone). The sweeps are kept as zone
-        indices, not memoised as sweeps: a (Z,) array for every face of every pair of a
-        many-zone graph is more memory than the graph."""
+        on the pair (s, e) (memoised), or None when ``deadline`` passes first. A face next to a
+        target zone is left out (groups 1-3 place it by that zone): a placeholder zone, not ok."""
         hit = self._reach.get((s, e))
         if hit is None:
+            floods = self._floods_of(s, e, deadline)
+            if floods is None:
+                return None
             beyond = self._beyond[(s, e)]
-            outside = (beyond >= 0) & ~self.target[np.maximum(beyond, 0)]
-            ok: list[bool] = []
-            zones: list[int] = []
-            starts: list[int] = []
-            for face, swept_needed in zip(self.faces_on[s].tolist(), outside.tolist(), strict=True):
-                if deadline is not None and deadline.passed():
-                    return None
-                swept = self._sweep(face, s, e) if swept_needed else None
-                starts.append(len(zones))
-                ok.append(swept is not None)
-                zones.extend(swept.members.tolist() if swept is not None else [0])
-            hit = self._reach[(s, e)] = _Reach(
-                np.array(ok, bool), np.array(zones, np.int32), np.array(starts, np.int64)
-            )
+            ok = (beyond >= 0) & ~self.target[np.maximum(beyond, 0)] & (floods.fills > 0)
+            counts = np.where(ok, np.diff(floods.starts), 1)
+            at = _spans(floods.starts[:-1], counts)
+            members = floods.members if len(floods.members) else np.zeros(1, np.int32)
+            zones = np.where(np.repeat(ok, counts), members[np.minimum(at, len(members) - 1)], 0)
+            starts = (np.cumsum(counts) - counts).astype(np.int64)
+            hit = self._reach[(s, e)] = _Reach(ok, zones.astype(np.int32), starts)
         return hit
 
     def _faces_under(self, zones: np.ndarray, s: int, e: int) -> list[int]:
@@ -403,30 +501,31 @@ class ProposalGenerator:
         valid = beyond >= 0
         return self.faces_on[s][valid & zones[np.where(valid, beyond, 0)]].tolist()
 
-    def _sides(self, plane: int) -> list[int]:
-        """Each zone's side of a plane (``plane_side`` row) as a list: a sweep reads it zone by
-        zone, and indexing a NumPy row one zone at a time dominated a sweep's cost."""
-        if plane not in self._side_lists:
-            self._side_lists[plane] = self.graph.plane_side[plane].tolist()
-        return self._side_lists[plane]
+    @cached_property
+    def _face_frames(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """What `_crossings` reads of every face, whatever the direction: (F,) bool planar,
+        (F, 3) its normal (0 where curved), (F,) bool on a side-wall surface, (F, 3) that
+        surface's axis. Made once: per plane pair they were most of `_crossings`' time."""
+        g = self.graph
+        planar = np.isfinite(g.face_normal[:, 0])
+        surface = g.face_surface
+        wall = (surface >= 0) & np.isin(g.surface_kind[np.maximum(surface, 0)], SIDE_WALL_KINDS)
+        normals = np.where(planar[:, None], g.face_normal, 0.0)
+        return planar, normals, wall, np.ascontiguousarray(g.surface_axis[np.maximum(surface, 0), 3:])
 
-    def _crossings(self, d: np.ndarray, length: float) -> tuple[list[bool], list[bool]]:
+    def _crossings(self, d: np.ndarray, length: float) -> tuple[np.ndarray, np.ndarray]:
         """For every face, whether a sweep along d (of ``length``) goes on through it out of its
         first zone, and out of its second (kept per plane pair by `_slab`): a planar face
         when it faces along d (a cap); a curved face unless it lies on a cylinder or extrusion
         along d (a side wall); never a face inside one zone (the sweep is on both of its sides
         already). Classifying all faces at once replaced a per-face test that was half a sweep's
         cost on graphs of thousands of zones."""
-        g = self.graph
-        planar = np.isfinite(g.face_normal[:, 0])
-        along = np.where(planar[:, None], g.face_normal, 0.0) @ d  # face normals point a -> b
-        surface = g.face_surface
-        wall = (surface >= 0) & np.isin(g.surface_kind[np.maximum(surface, 0)], SIDE_WALL_KINDS)
-        axis = g.surface_axis[np.maximum(surface, 0), 3:] @ d
-        curved = ~wall | (1 - np.abs(axis) / length >= PARALLEL_TOL)
+        planar, normals, wall, axes = self._face_frames
+        along = normals @ d  # face normals point a -> b
+        curved = ~wall | (1 - np.abs(axes @ d) / length >= PARALLEL_TOL)
         from_a = np.where(planar, along > PARALLEL_TOL * length, curved) & ~self.internal
         from_b = np.where(planar, -along > PARALLEL_TOL * length, curved) & ~self.internal
-        return from_a.tolist(), from_b.tolist()
+        return from_a, from_b
 
     # ------------------------------------------------------------------------ proposals
 
@@ -491,15 +590,19 @@ class ProposalGenerator:
     def _sweep_faces(self, faces: list[int], s: int, e: int) -> _Swept | None:
         """The faces' sweeps joined (the zones, and the faces on s their shared sweeps stand on),
         or None when a face's prism is not filled: a component's, or a whole sketch's."""
+        floods = self._floods_of(s, e, None)
+        assert floods is not None  # no deadline
+        at = np.searchsorted(self.faces_on[s], faces)
+        fills = floods.fills[at]
+        if not fills.all():
+            return None
         volume = np.zeros(self.graph.n_zones, bool)
+        volume[floods.members[_spans(floods.starts[at], floods.starts[at + 1] - floods.starts[at])]] = True
         needs: set[int] = set()
-        for f in faces:
-            swept = self.sweep(f, s, e)
-            if swept is None:
-                return None
-            if len(swept.faces) > 1:
-                needs.update(swept.faces)
-            volume[swept.members] = True
+        for i in np.flatnonzero(fills == SHARED).tolist():
+            swept = self.sweep(faces[i], s, e)
+            assert swept is not None
+            needs.update(swept.faces)
         return volume, needs
 
     def extrusion(self, faces: tuple[int, ...], s: int, e: int) -> np.ndarray | None:
@@ -535,7 +638,8 @@ class ProposalGenerator:
             swept = [part for part in (parts[c] for c in combo) if part is not None]
             if len(swept) < len(combo):
                 continue  # a face's prism is not filled
-            sketch = tuple(sorted(f for c in combo for f in comps[c]))
+            faces = comps[combo[0]] if len(combo) == 1 else sorted(f for c in combo for f in comps[c])
+            sketch = tuple(faces)
             needed = set().union(*(needs for _, needs in swept))
             if needed and not needed.issubset(sketch):
                 continue  # a shared sweep stands on faces outside the sketch
