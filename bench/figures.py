@@ -422,6 +422,23 @@ def heavy_figure(rows: list[dict]) -> dict:
     }
 
 
+EXPANSION_FIELDS = ("zones", "first_expansion_cpu_s", "search_cpu_s", "exact", "expansions")
+
+
+def expansion_figure(rows: list[dict]) -> dict:
+    """The expansion benchmark: the spread of first-expansion and search CPU seconds, and each
+    graph's own figures (to set two checkouts' runs side by side)."""
+    return {
+        "graphs": len(rows),
+        "exact": sum(r["exact"] for r in rows),
+        "first_expansion_cpu_s": _spread([r["first_expansion_cpu_s"] for r in rows]),
+        "search_cpu_s": _spread([r["search_cpu_s"] for r in rows]),
+        "first_expansion_total_s": round(sum(r["first_expansion_cpu_s"] for r in rows), 3),
+        "search_total_s": round(sum(r["search_cpu_s"] for r in rows), 3),
+        "designs": {r["design_id"]: {k: r[k] for k in EXPANSION_FIELDS} for r in rows},
+    }
+
+
 def startup_figure(results: Path) -> dict:
     """The start-up benchmark by part: each process's CPU, wall and peak memory per column (ours
     cold, ours handed to a server, the original), and the server's own start where it ran."""
@@ -457,6 +474,7 @@ FIGURES_OF = {
     "guide-cost": guide_cost_figure,
     "rank": rank_figure,
     "heavy": heavy_figure,
+    "expansion": expansion_figure,
 }
 
 

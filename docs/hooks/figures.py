@@ -411,6 +411,48 @@ def heavy(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
 
 
+def expansion(records: list[dict]) -> str:
+    """Runs of the expansion benchmark side by side (oldest first): the CPU seconds' spread per run,
+    then the ten graphs of the costliest first expansions in the first run as ``before → after``."""
+
+    def spread(s: dict) -> str:
+        return f"{s['median']:.4f} / {s['p90']:.4f} / {s['max']:.3f}"
+
+    lines = [
+        "| run | graphs | exact | first expansion CPU s: median / p90 / max (total) "
+        "| search CPU s: median / p90 / max (total) |",
+        "|---|---|---|---|---|",
+    ]
+    for r in records:
+        f = r["figure"]
+        first = f"{spread(f['first_expansion_cpu_s'])} ({f['first_expansion_total_s']:.2f})"
+        searched = f"{spread(f['search_cpu_s'])} ({f['search_total_s']:.2f})"
+        lines.append(_row(r["name"], [str(f["graphs"]), str(f["exact"]), first, searched]))
+    designs = records[0]["figure"]["designs"]
+    costliest = sorted(designs, key=lambda d: -designs[d]["first_expansion_cpu_s"])[:10]
+    lines += [
+        "",
+        "| design | zones | first expansion CPU s | search CPU s | exact | expansions |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name in costliest:
+        runs = [r["figure"]["designs"].get(name) for r in records]
+        cells = [" → ".join(_value(d, key) for d in runs) for key in EXPANSION_KEYS]
+        lines.append(_row(name, [str(designs[name]["zones"]), *cells]))
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+EXPANSION_KEYS = ("first_expansion_cpu_s", "search_cpu_s", "exact", "expansions")
+
+
+def _value(figures: dict | None, key: str) -> str:
+    """One design's figure in a run, "-" where the run did not measure the design."""
+    if figures is None:
+        return "-"
+    value = figures[key]
+    return f"{value:.3f}" if isinstance(value, float) else str(value)
+
+
 STAGE_ORDER = (
     "generate",
     "replay",
@@ -532,6 +574,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "report": report,
     "rank": rank,
     "heavy": heavy,
+    "expansion": expansion,
     "pipeline-run": pipeline_run,
     "startup": startup,
     "cover": cover,

@@ -13,6 +13,7 @@ from bench.figures import (
     conversion_figure,
     corpus_figure,
     coverage_figure,
+    expansion_figure,
     fault_figure,
     fuzz_figure,
     guide_cost_figure,
@@ -427,3 +428,25 @@ def test_a_startup_figure_compares_cold_and_warm_calls_with_the_original(tmp_pat
     assert f"- build warm CPU / the original's: {ratios}" in table
     assert "- original: 2 of 3 exited 0" in table and "smallest part by STEP size, small" in table
     assert "the server's start, once: 3.50 s wall, 3.40 CPU s and 480 MB" in table
+
+
+def test_the_expansion_figure_sets_two_runs_side_by_side():
+    """Two checkouts' runs of bench.expansion_bench: the spread per run, and the costliest first
+    expansions of the first run as before → after ("-" where the second run lacks the graph)."""
+    rows = [
+        {"design_id": "big", "zones": 1544, "first_expansion_cpu_s": 1.08, "search_cpu_s": 1.4}
+        | {"exact": True, "expansions": 10},
+        {"design_id": "small", "zones": 6, "first_expansion_cpu_s": 0.002, "search_cpu_s": 0.002}
+        | {"exact": True, "expansions": 1},
+    ]
+    after = [rows[0] | {"first_expansion_cpu_s": 0.32, "search_cpu_s": 0.65}]
+    records = [
+        {"name": n, "command": "python -m bench.expansion_bench", "commit": c, "measured": "2026-12-07"}
+        | {"figure": expansion_figure(r)}
+        for n, c, r in (("before", "f8a76ed", rows), ("after", "7ce69a5", after))
+    ]
+    assert records[0]["figure"]["first_expansion_total_s"] == 1.082
+    table = _hook().expansion(records)
+    assert "| before | 2 | 2 | 0.5410 / 0.9722 / 1.080 (1.08) |" in table
+    assert "| big | 1544 | 1.080 → 0.320 | 1.400 → 0.650 | True → True | 10 → 10 |" in table
+    assert "| small | 6 | 0.002 → - |" in table

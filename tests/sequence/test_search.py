@@ -138,3 +138,36 @@ def test_a_step_that_completes_the_target_is_taken_without_scoring():
     ranker = CountingRanker()
     result = search(step, ranker, SearchConfig(budget_s=10, k=50))
     assert result.exact and ranker.calls == result.expansions - 1
+
+
+class Wanderer:
+    """Tries only the state's worst proposal by the heuristic; with ``after``, offers a second walk
+    in the heuristic's order after that many expansions."""
+
+    def __init__(self, after: int | None = None) -> None:
+        self.after = after
+
+    def score(self, graph, canvas, proposals):
+        return -HeuristicRanker().score(graph, canvas, proposals)
+
+    def order_at(self, graph, canvas, proposals, step, k):
+        return iter([int(np.argmax(self.score(graph, canvas, proposals)))])
+
+    def relay(self):
+        return None if self.after is None else (self.after, HeuristicRanker())
+
+
+def test_a_relay_walk_from_the_empty_canvas_takes_turns_with_the_first():
+    """A plate with a boss, a hole and a pocket (several steps): the wanderer's own walk never
+    reaches it; with a relay after 3 expansions the heuristic's walk starts from the empty canvas
+    and, a state each, finds the heuristic's own program, at the cost of the wanderer's turns."""
+    part = Box(6, 4, 1) + Pos(-1.5, 0, 1) * Cylinder(0.8, 1) - Pos(1.5, 1, 0) * Cylinder(0.4, 1)
+    g = graph_of(part - Pos(1.5, -1, 0.5) * Box(1, 1, 0.5))
+    config = SearchConfig(budget_s=20, max_expansions=400)
+    alone = search(g, Wanderer(), config)
+    heuristic = search(g, HeuristicRanker(), config)
+    relayed = search(g, Wanderer(after=3), config)
+    assert not alone.exact and alone.ended == "exhausted" and heuristic.exact
+    assert relayed.exact and [p.key for p in relayed.steps] == [p.key for p in heuristic.steps]
+    first_walk = min(heuristic.expansions - 1, alone.expansions - 3)  # its turns after the relay began
+    assert relayed.expansions == 3 + heuristic.expansions + first_walk

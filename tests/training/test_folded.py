@@ -226,6 +226,18 @@ def test_a_waking_guide_orders_every_state_by_the_network_once_the_search_backtr
 
 
 @requires_samples
+def test_a_relaying_guide_hands_the_search_the_network_ordering_every_state(states):
+    graph, canvas, proposals = states[0]
+    scores = NetworkRanker().score_at(graph, canvas, proposals, 1)
+    eager = [int(i) for i in np.argsort(-scores, kind="stable")]
+    ranker = NetworkRanker(defer=True, relay=7)
+    after, second = ranker.relay()
+    assert after == 7 and second.scorer is ranker.scorer and ranker.defer
+    assert list(second.order_at(graph, canvas, proposals, 1, 5)) == eager[:5]
+    assert second.relay() is None and NetworkRanker(defer=False, relay=7).relay() is None
+
+
+@requires_samples
 def test_the_shipped_weights_are_read_on_the_first_state_the_network_scores(states):
     ranker = NetworkRanker()
     assert not ranker.scorer.loaded and ranker.top_m == FoldedScorer.load(SHIPPED_FOLDED).search["top_m"]

@@ -20,7 +20,10 @@ first choice of a state unscored and asks the network only when the search comes
 second one (a search that never backtracks costs what the heuristic's does), and ``wake``, with
 ``defer``, lets the network order every state of a graph from the first time the search backtracks
 in it on: a design the heuristic's first choices solve costs what the heuristic's search does, one
-where they failed once is searched in the network's order. A checkpoint may carry its own
+where they failed once is searched in the network's order; and ``relay`` N, with ``defer``, starts
+a second walk from the empty canvas after N expansions without the target, ordered by the network
+alone, the two walks taking turns (`zonegraph.sequence.best_first.search`): a wrong first choice
+near the root is never undone by backtracking within the budget. A checkpoint may carry its own
 defaults (its ``search`` entry); the arguments override them. A state where a proposal completes
 the target never reaches a ranker in search (`zonegraph.sequence.best_first` takes that step
 unscored), so where the guide is asked to rank one (the relative GT rank), the network ranks it
@@ -29,6 +32,7 @@ with its own scores, as the paper's network ranks every state.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Iterator
 from functools import cache
 from pathlib import Path
@@ -173,6 +177,7 @@ class NetworkRanker:
         margin: float | None = None,
         defer: bool | None = None,
         wake: bool | None = None,
+        relay: int | None = None,
     ) -> None:
         path = Path(model) if model else SHIPPED_FOLDED
         if not path.is_file():
@@ -185,6 +190,7 @@ class NetworkRanker:
         self.margin: float | None = margin if margin is not None else search.get("margin")
         self.defer = bool(defer if defer is not None else search.get("defer", False))
         self.wake = bool(wake if wake is not None else search.get("wake", False))
+        self.relay_after: int | None = (relay if relay is not None else search.get("relay")) or None
         self._woken: ZoneGraph | None = None  # the graph in whose search the network took over
         self._heuristic = HeuristicRanker()
         self._graph: ZoneGraph | None = None
@@ -193,6 +199,15 @@ class NetworkRanker:
     def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
         """(P,) scores of one state whose depth is not known (the step feature reads 0)."""
         return self.score_at(graph, canvas, proposals, 0)
+
+    def relay(self) -> tuple[int, NetworkRanker] | None:
+        """With ``relay`` N and ``defer``: N, and this guide ordering every state itself (the
+        search's second walk); else None."""
+        if not (self.relay_after and self.defer):
+            return None
+        second = copy.copy(self)  # the same scorer and its per-graph encodings
+        second.defer, second.wake, second.relay_after, second._woken = False, False, None, None
+        return self.relay_after, second
 
     def order_at(
         self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int, k: int

@@ -97,6 +97,77 @@ class _Frame:
     children: Iterator[Proposal]
 
 
+class _Search:
+    """What the walks of one search share: the generator and its budget, the best canvas so far
+    with its anytime trace, and the per-expansion statistics."""
+
+    def __init__(self, graph: ZoneGraph, config: SearchConfig, gen: ProposalGenerator, deadline: Deadline):
+        self.graph, self.config, self.gen, self.deadline = graph, config, gen, deadline
+        self.target = graph.zone_inside.astype(bool)
+        self.t0 = time.perf_counter()
+        self.empty = np.zeros(graph.n_zones, bool)
+        iou = zone_iou(graph, self.empty, self.target)
+        self.best: tuple[float, int, np.ndarray, list[Proposal]] = (iou, 0, self.empty, [])
+        self.trace = [(0.0, iou)]
+        self.time_to_best = 0.0
+        self.exact = zone_exact(graph, self.empty, self.target)
+        self.counts: list[int] = []
+        self.times: list[float] = []
+
+    def expand(self, ranker: Ranker, canvas: np.ndarray, path: list[Proposal]) -> Iterator[Proposal]:
+        """A state's proposals in the order the walk tries them: a completing one alone, else
+        the ranker's best ``k``."""
+        start = time.perf_counter()
+        used = {p.inverse_key for p in path}
+        props = [p for p in self.gen.proposals(canvas, self.deadline) if p.key not in used]
+        self.counts.append(len(props))
+        order: Iterator[int] = iter(())
+        if props and not self.deadline.passed():  # past it, the search stops: nothing to score for
+            done = _finishing(self.graph, canvas, self.target, props)[:1]
+            k = self.config.k_at(len(path))
+            order = iter(done) if done else order_step(ranker, self.graph, canvas, props, len(path), k)
+        self.times.append(time.perf_counter() - start)
+        return (props[i] for i in order)
+
+    def reached(self, canvas: np.ndarray, path: list[Proposal]) -> None:
+        """Keep ``canvas`` if it is the best so far (highest zone IoU, then fewest steps)."""
+        iou = zone_iou(self.graph, canvas, self.target)
+        if (iou, -len(path)) > (self.best[0], -self.best[1]):
+            self.best = (iou, len(path), canvas, path)
+            self.time_to_best = time.perf_counter() - self.t0
+            self.trace.append((self.time_to_best, iou))
+        self.exact = zone_exact(self.graph, canvas, self.target)
+
+
+class _Walk:
+    """One depth-first walk from the empty canvas, ordered by one ranker: its stack, and the
+    canvases it has seen (a canvas reached before is a dead end)."""
+
+    def __init__(self, search: _Search, ranker: Ranker) -> None:
+        self.search, self.ranker = search, ranker
+        self.seen = {np.packbits(search.empty).tobytes()}
+        self.stack = [_Frame(search.empty, [], search.expand(ranker, search.empty, []))]
+
+    def step(self) -> bool:
+        """Try the next child of the deepest state: True when a new state was expanded."""
+        frame = self.stack[-1]
+        child = next(frame.children, None)
+        if child is None:
+            self.stack.pop()
+            return False
+        canvas = child.apply(frame.canvas)
+        key = np.packbits(canvas).tobytes()
+        if key in self.seen:
+            return False
+        self.seen.add(key)
+        path = frame.path + [child]
+        self.search.reached(canvas, path)
+        if self.search.exact or len(path) >= self.search.config.max_depth:
+            return False
+        self.stack.append(_Frame(canvas, path, self.search.expand(self.ranker, canvas, path)))
+        return True
+
+
 def search(
     graph: ZoneGraph,
     ranker: Ranker,
@@ -105,6 +176,11 @@ def search(
     deadline: Deadline | None = None,
 ) -> SearchResult:
     """Find a proposal sequence whose canvas equals the target's zones (best-first, top-k).
+
+    A ranker may offer ``relay() -> (n, second ranker)``: once ``n`` states are expanded without
+    the target, a second walk starts from the empty canvas in the second ranker's order and the
+    two walks take turns, a state each (the network guide's ``relay``: where the heuristic's
+    first choices went wrong near the root, backtracking deep in their subtree cannot undo them).
 
     Args:
         graph: the zone graph; its ``zone_inside`` is the target.
@@ -122,71 +198,38 @@ def search(
     """
     if deadline is None:
         deadline = Deadline.after(config.budget_s)
-    gen = generator or ProposalGenerator(graph)
-    target = graph.zone_inside.astype(bool)
-    t0 = time.perf_counter()
-    empty = np.zeros(graph.n_zones, bool)
-    best: tuple[float, int, np.ndarray, list[Proposal]] = (zone_iou(graph, empty, target), 0, empty, [])
-    trace = [(0.0, best[0])]
-    time_to_best = 0.0
-    seen = {np.packbits(empty).tobytes()}
-    counts: list[int] = []
-    times: list[float] = []
-
-    def expand(canvas: np.ndarray, path: list[Proposal]) -> Iterator[Proposal]:
-        start = time.perf_counter()
-        used = {p.inverse_key for p in path}
-        props = [p for p in gen.proposals(canvas, deadline) if p.key not in used]
-        counts.append(len(props))
-        order: Iterator[int] = iter(())
-        if props and not deadline.passed():  # past it, the search stops: nothing to score for
-            done = _finishing(graph, canvas, target, props)[:1]
-            k = config.k_at(len(path))
-            order = iter(done) if done else order_step(ranker, graph, canvas, props, len(path), k)
-        times.append(time.perf_counter() - start)
-        return (props[i] for i in order)
-
-    stack = [_Frame(empty, [], expand(empty, []))]
-    exact = zone_exact(graph, empty, target)
+    state = _Search(graph, config, generator or ProposalGenerator(graph), deadline)
+    relay = getattr(ranker, "relay", None)
+    second: tuple[int, Ranker] | None = relay() if relay is not None else None
+    walks = [_Walk(state, ranker)]
+    turn = 0
     ended = "exhausted"
-    while stack and not exact:
+    while not state.exact:
         if deadline.passed():
             ended = "budget"
             break
-        if config.max_expansions and len(counts) >= config.max_expansions:
+        if config.max_expansions and len(state.counts) >= config.max_expansions:
             ended = "expansions"
             break
-        frame = stack[-1]
-        child = next(frame.children, None)
-        if child is None:
-            stack.pop()
+        walks = [walk for walk in walks if walk.stack]
+        if second is not None and (len(state.counts) >= second[0] or not walks):
+            walks.append(_Walk(state, second[1]))  # its first state expanded as it starts
+            second, turn = None, len(walks)  # so the first walk goes next
             continue
-        canvas = child.apply(frame.canvas)
-        key = np.packbits(canvas).tobytes()
-        if key in seen:
-            continue
-        seen.add(key)
-        path = frame.path + [child]
-        iou = zone_iou(graph, canvas, target)
-        if (iou, -len(path)) > (best[0], -best[1]):
-            best = (iou, len(path), canvas, path)
-            time_to_best = time.perf_counter() - t0
-            trace.append((time_to_best, iou))
-        if zone_exact(graph, canvas, target):
-            exact = True
+        if not walks:
             break
-        if len(path) < config.max_depth:
-            stack.append(_Frame(canvas, path, expand(canvas, path)))
+        if walks[turn % len(walks)].step():
+            turn += 1
     return SearchResult(
-        exact=exact,
-        iou=best[0],
-        steps=best[3],
-        canvas=best[2],
-        expansions=len(counts),
-        seconds=time.perf_counter() - t0,
-        time_to_best_s=time_to_best,
-        trace=trace,
-        proposals_per_state=counts,
-        expansion_s=times,
-        ended="exact" if exact else ended,
+        exact=state.exact,
+        iou=state.best[0],
+        steps=state.best[3],
+        canvas=state.best[2],
+        expansions=len(state.counts),
+        seconds=time.perf_counter() - state.t0,
+        time_to_best_s=state.time_to_best,
+        trace=state.trace,
+        proposals_per_state=state.counts,
+        expansion_s=state.times,
+        ended="exact" if state.exact else ended,
     )
