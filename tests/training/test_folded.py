@@ -226,15 +226,20 @@ def test_a_waking_guide_orders_every_state_by_the_network_once_the_search_backtr
 
 
 @requires_samples
-def test_a_relaying_guide_hands_the_search_the_network_ordering_every_state(states):
+def test_a_relaying_guide_orders_by_the_heuristic_and_hands_the_search_the_network(states):
     graph, canvas, proposals = states[0]
+    heuristic = np.argsort(-HeuristicRanker().score(graph, canvas, proposals), kind="stable").tolist()
     scores = NetworkRanker().score_at(graph, canvas, proposals, 1)
     eager = [int(i) for i in np.argsort(-scores, kind="stable")]
-    ranker = NetworkRanker(defer=True, relay=7)
+    ranker = NetworkRanker(relay=7)
+    calls = []
+    scorer_score = ranker.scorer.score
+    ranker.scorer.score = lambda *args: calls.append(1) or scorer_score(*args)  # type: ignore[method-assign]
+    assert list(ranker.order_at(graph, canvas, proposals, 1, 5)) == heuristic[:5] and not calls
     after, second = ranker.relay()
-    assert after == 7 and second.scorer is ranker.scorer and ranker.defer
-    assert list(second.order_at(graph, canvas, proposals, 1, 5)) == eager[:5]
-    assert second.relay() is None and NetworkRanker(defer=False, relay=7).relay() is None
+    assert after == 7 and second.scorer is ranker.scorer and second.relay() is None
+    assert list(second.order_at(graph, canvas, proposals, 1, 5)) == eager[:5] and calls
+    assert NetworkRanker().relay() is None  # the shipped guide does not relay
 
 
 @requires_samples

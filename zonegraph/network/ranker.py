@@ -20,14 +20,17 @@ first choice of a state unscored and asks the network only when the search comes
 second one (a search that never backtracks costs what the heuristic's does), and ``wake``, with
 ``defer``, lets the network order every state of a graph from the first time the search backtracks
 in it on: a design the heuristic's first choices solve costs what the heuristic's search does, one
-where they failed once is searched in the network's order; and ``relay`` N, with ``defer``, starts
-a second walk from the empty canvas after N expansions without the target, ordered by the network
-alone, the two walks taking turns (`zonegraph.sequence.best_first.search`): a wrong first choice
-near the root is never undone by backtracking within the budget. A checkpoint may carry its own
-defaults (its ``search`` entry); the arguments override them. A state where a proposal completes
-the target never reaches a ranker in search (`zonegraph.sequence.best_first` takes that step
-unscored), so where the guide is asked to rank one (the relative GT rank), the network ranks it
-with its own scores, as the paper's network ranks every state.
+where they failed once is searched in the network's order; and ``relay`` N searches in the
+heuristic's order alone (no network call) and, after N expansions without the target, starts a
+second walk from the empty canvas in the network's order (every state scored), the two walks
+taking turns (`zonegraph.sequence.best_first.search`): a design the heuristic solves within N
+expansions costs what the heuristic's search does, and a wrong first choice near the root, which
+backtracking deep in its subtree does not undo within a budget, is not the only way left. A
+checkpoint may carry its own defaults (its ``search`` entry); the arguments override them. A state
+where a proposal completes the target never reaches a ranker in search
+(`zonegraph.sequence.best_first` takes that step unscored), so where the guide is asked to rank
+one (the relative GT rank), the network ranks it with its own scores, as the paper's network
+ranks every state.
 """
 
 from __future__ import annotations
@@ -201,9 +204,9 @@ class NetworkRanker:
         return self.score_at(graph, canvas, proposals, 0)
 
     def relay(self) -> tuple[int, NetworkRanker] | None:
-        """With ``relay`` N and ``defer``: N, and this guide ordering every state itself (the
-        search's second walk); else None."""
-        if not (self.relay_after and self.defer):
+        """With ``relay`` N: N, and this guide ordering every state itself (the search's second
+        walk); else None."""
+        if not self.relay_after:
             return None
         second = copy.copy(self)  # the same scorer and its per-graph encodings
         second.defer, second.wake, second.relay_after, second._woken = False, False, None, None
@@ -215,9 +218,12 @@ class NetworkRanker:
         """At most ``k`` proposals of one state, best first, as the search asks for them: ordered
         by `score_at`, or with ``defer`` the heuristic's first choice, then (scored only when
         the search backtracks to this state) the network's order of the others; with ``wake``
-        every state of a graph is ordered by `score_at` once the search has backtracked in it."""
+        every state of a graph is ordered by `score_at` once the search has backtracked in it;
+        with ``relay`` by the heuristic (the network orders the search's second walk)."""
         if step == 0:  # a search's first state: a new search, asleep again
             self._woken = None
+        if self.relay_after:  # the first walk of a relay: the heuristic's order
+            return iter(best_first(self._heuristic.score(graph, canvas, proposals))[:k])
         if not self.defer or self._woken is graph:
             return iter(best_first(self.score_at(graph, canvas, proposals, step))[:k])
         heuristic = self._heuristic.score(graph, canvas, proposals)
