@@ -154,7 +154,7 @@ class Wanderer:
         return iter([int(np.argmax(self.score(graph, canvas, proposals)))])
 
     def relay(self):
-        return None if self.after is None else (self.after, HeuristicRanker())
+        return None if self.after is None else (self.after, HeuristicRanker)
 
 
 def test_a_relay_walk_from_the_empty_canvas_takes_turns_with_the_first():

@@ -236,7 +236,8 @@ def test_a_relaying_guide_orders_by_the_heuristic_and_hands_the_search_the_netwo
     scorer_score = ranker.scorer.score
     ranker.scorer.score = lambda *args: calls.append(1) or scorer_score(*args)  # type: ignore[method-assign]
     assert list(ranker.order_at(graph, canvas, proposals, 1, 5)) == heuristic[:5] and not calls
-    after, second = ranker.relay()
+    after, make = ranker.relay()
+    second = make()
     assert after == 7 and second.scorer is ranker.scorer and second.relay() is None
     assert list(second.order_at(graph, canvas, proposals, 1, 5)) == eager[:5] and calls
     assert NetworkRanker().relay() is None  # the shipped guide does not relay

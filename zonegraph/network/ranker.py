@@ -36,7 +36,7 @@ ranks every state.
 from __future__ import annotations
 
 import copy
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from functools import cache
 from pathlib import Path
 from typing import Any, Protocol
@@ -203,14 +203,15 @@ class NetworkRanker:
         """(P,) scores of one state whose depth is not known (the step feature reads 0)."""
         return self.score_at(graph, canvas, proposals, 0)
 
-    def relay(self) -> tuple[int, NetworkRanker] | None:
-        """With ``relay`` N: N, and this guide ordering every state itself (the search's second
-        walk); else None."""
-        if not self.relay_after:
-            return None
+    def relay(self) -> tuple[int, Callable[[], NetworkRanker]] | None:
+        """With ``relay`` N: N, and how to make the search's second walk's guide (this one
+        ordering every state itself), made only if the relay starts; else None."""
+        return (self.relay_after, self._relayed) if self.relay_after else None
+
+    def _relayed(self) -> NetworkRanker:
         second = copy.copy(self)  # the same scorer and its per-graph encodings
         second.defer, second.wake, second.relay_after, second._woken = False, False, None, None
-        return self.relay_after, second
+        return second
 
     def order_at(
         self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal], step: int, k: int

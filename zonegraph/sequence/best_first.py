@@ -14,7 +14,7 @@ feeds IoU-vs-time curves.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -177,10 +177,11 @@ def search(
 ) -> SearchResult:
     """Find a proposal sequence whose canvas equals the target's zones (best-first, top-k).
 
-    A ranker may offer ``relay() -> (n, second ranker)``: once ``n`` states are expanded without
-    the target, a second walk starts from the empty canvas in the second ranker's order and the
-    two walks take turns, a state each (the network guide's ``relay``: where the heuristic's
-    first choices went wrong near the root, backtracking deep in their subtree cannot undo them).
+    A ranker may offer ``relay() -> (n, make)``: once ``n`` states are expanded without the target
+    (or its own walk is exhausted), a second walk starts from the empty canvas in the order of the
+    ranker ``make()`` returns, and the two walks take turns, a state each (the network guide's
+    ``relay``: where the heuristic's first choices went wrong near the root, backtracking deep in
+    their subtree cannot undo them).
 
     Args:
         graph: the zone graph; its ``zone_inside`` is the target.
@@ -200,7 +201,7 @@ def search(
         deadline = Deadline.after(config.budget_s)
     state = _Search(graph, config, generator or ProposalGenerator(graph), deadline)
     relay = getattr(ranker, "relay", None)
-    second: tuple[int, Ranker] | None = relay() if relay is not None else None
+    second: tuple[int, Callable[[], Ranker]] | None = relay() if relay is not None else None
     walks = [_Walk(state, ranker)]
     turn = 0
     ended = "exhausted"
@@ -213,7 +214,7 @@ def search(
             break
         walks = [walk for walk in walks if walk.stack]
         if second is not None and (len(state.counts) >= second[0] or not walks):
-            walks.append(_Walk(state, second[1]))  # its first state expanded as it starts
+            walks.append(_Walk(state, second[1]()))  # its first state expanded as it starts
             second, turn = None, len(walks)  # so the first walk goes next
             continue
         if not walks:
