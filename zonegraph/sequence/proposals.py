@@ -265,7 +265,6 @@ class ProposalGenerator:
         self.faces_on = {int(s): np.flatnonzero(graph.face_surface == s) for s in planes}
         self._links_on = self._links_by_plane(planes)
         self._local_links = self._local_links_by_plane()
-        self._zone_faces = self._faces_of_zones()
         self._sweeps: dict[tuple[int, int, int], Sweep | None] = {}
         self._groups: Memo[_Candidates] = Memo(MEMO_BYTES["groups"], lambda c: c.nbytes)
         self._comps: Memo[list[list[int]]] = Memo(
@@ -341,15 +340,6 @@ class ProposalGenerator:
         g = self.graph
         n = g.surface_normal[s]
         return n * (g.surface_offset[e] * float(n @ g.surface_normal[e]) - g.surface_offset[s])
-
-    def _faces_of_zones(self) -> list[np.ndarray]:
-        fz = self.graph.face_zones
-        out: list[list[int]] = [[] for _ in range(self.graph.n_zones)]
-        for f, (a, b) in enumerate(fz):
-            out[a].append(f)
-            if b >= 0:
-                out[b].append(f)
-        return [np.array(x, np.int64) for x in out]
 
     def _zones_beyond(self, s: int, e: int) -> np.ndarray:
         """For each face on s: the zone on its d side (-1 if none)."""
