@@ -210,7 +210,7 @@ class NetworkRanker:
 
     def _relayed(self) -> NetworkRanker:
         second = copy.copy(self)  # the same scorer and its per-graph encodings
-        second.defer, second.wake, second.relay_after, second._woken = False, False, None, None
+        second.defer, second.relay_after = False, None
         return second
 
     def order_at(

@@ -212,14 +212,16 @@ def search(
         if config.max_expansions and len(state.counts) >= config.max_expansions:
             ended = "expansions"
             break
-        walks = [walk for walk in walks if walk.stack]
         if second is not None and (len(state.counts) >= second[0] or not walks):
             walks.append(_Walk(state, second[1]()))  # its first state expanded as it starts
             second, turn = None, len(walks)  # so the first walk goes next
             continue
         if not walks:
             break
-        if walks[turn % len(walks)].step():
+        walk = walks[turn % len(walks)]
+        if not walk.stack:
+            walks.remove(walk)  # exhausted
+        elif walk.step():
             turn += 1
     return SearchResult(
         exact=state.exact,

@@ -376,8 +376,7 @@ class ProposalGenerator:
         return slab
 
     def _sweep(self, face: int, s: int, e: int) -> Sweep | None:
-        floods = self._floods_of(s, e, None)
-        assert floods is not None  # no deadline
+        floods = self._floods_of(s, e)
         i = int(np.searchsorted(self.faces_on[s], face))
         fill = int(floods.fills[i])
         if not fill:
@@ -389,13 +388,11 @@ class ProposalGenerator:
         zones[members] = True
         return Sweep(members, tuple(self._faces_under(zones, s, e)), self.graph.n_zones)
 
-    def _floods_of(self, s: int, e: int, deadline: Deadline | None) -> _Floods | None:
+    def _floods_of(self, s: int, e: int) -> _Floods:
         """The pair's `_Floods` (memoised), made with the pairs after it that are not made yet
-        as far as `FLOOD_CELLS` allows, or None when ``deadline`` has passed."""
+        as far as `FLOOD_CELLS` allows."""
         floods = self._floods.get((s, e))
         if floods is None:
-            if deadline is not None and deadline.passed():
-                return None
             width = self.graph.n_zones + 1
             batch: list[tuple[int, int]] = []
             cells = 0
@@ -472,9 +469,9 @@ class ProposalGenerator:
         target zone is left out (groups 1-3 place it by that zone): a placeholder zone, not ok."""
         hit = self._reach.get((s, e))
         if hit is None:
-            floods = self._floods_of(s, e, deadline)
-            if floods is None:
+            if (s, e) not in self._floods and deadline is not None and deadline.passed():
                 return None
+            floods = self._floods_of(s, e)
             beyond = self._beyond[(s, e)]
             ok = (beyond >= 0) & ~self.target[np.maximum(beyond, 0)] & (floods.fills > 0)
             counts = np.where(ok, np.diff(floods.starts), 1)
@@ -580,8 +577,7 @@ class ProposalGenerator:
     def _sweep_faces(self, faces: list[int], s: int, e: int) -> _Swept | None:
         """The faces' sweeps joined (the zones, and the faces on s their shared sweeps stand on),
         or None when a face's prism is not filled: a component's, or a whole sketch's."""
-        floods = self._floods_of(s, e, None)
-        assert floods is not None  # no deadline
+        floods = self._floods_of(s, e)
         at = np.searchsorted(self.faces_on[s], faces)
         fills = floods.fills[at]
         if not fills.all():
