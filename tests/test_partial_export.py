@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import pytest
-from build123d import Face, Plane, Pos, Rectangle, Unit
+from build123d import Face, Plane, Pos, Rectangle, Shape, Unit
 
 import zonegraph.export.verify as verify
 from zonegraph.export.verify import PARTIAL_SLACK, verified_export
@@ -26,9 +26,9 @@ def face(plane: Plane, sketch: object) -> Face:
     return (plane * sketch).face()  # type: ignore[operator]
 
 
-# 40.0000013 is written as 40: the snapped pass changes numbers, so a raw pass can follow it.
 UP = (0.0, 0.0, 1.0)
 TOP = Plane.XY.offset(6)
+# 40.0000013 is written as 40: the snapped pass changes numbers, so a raw pass can follow it.
 BASE = face(Plane.XY, Pos(10, 5) * Rectangle(40.0000013, 20))
 PLATE = ProgramStep(Op.UNION, (BASE,), (0.0, 0.0, 0.0), UP, 6.0)
 TOWER = ProgramStep(Op.UNION, (face(TOP, Pos(10, 5) * Rectangle(10, 10)),), (0.0, 0.0, 6.0), UP, 10.0)
@@ -49,7 +49,7 @@ def passes(monkeypatch: pytest.MonkeyPatch) -> list[bool]:
     return seen
 
 
-def partial() -> tuple[list[ProgramStep], object, float]:
+def partial() -> tuple[list[ProgramStep], Shape, float]:
     target = execute([PLATE, TOWER])[-1]
     rebuilt = execute([PLATE])[-1]
     assert target is not None and rebuilt is not None
@@ -59,7 +59,7 @@ def partial() -> tuple[list[ProgramStep], object, float]:
 def test_files_within_a_thousandth_of_a_partial_rebuild_take_one_pass(passes: list[bool]) -> None:
     program, target, iou = partial()
     assert 0.8 < iou < 0.85  # the plate is 4,800 of the 5,800 mm3
-    export = verified_export(program, "part", Unit.MM, target, iou + PARTIAL_SLACK / 2, EXACT_IOU)  # type: ignore[arg-type]
+    export = verified_export(program, "part", Unit.MM, target, iou + PARTIAL_SLACK / 2, EXACT_IOU)
     assert passes == [True]
     assert export.snapped and export.design_snapped
     assert "Rectangle(40, 20)" in export.script
@@ -68,6 +68,6 @@ def test_files_within_a_thousandth_of_a_partial_rebuild_take_one_pass(passes: li
 
 def test_files_further_from_a_partial_rebuild_are_checked_raw_as_well(passes: list[bool]) -> None:
     program, target, iou = partial()
-    export = verified_export(program, "part", Unit.MM, target, iou + 2 * PARTIAL_SLACK, EXACT_IOU)  # type: ignore[arg-type]
+    export = verified_export(program, "part", Unit.MM, target, iou + 2 * PARTIAL_SLACK, EXACT_IOU)
     assert passes == [True, False]
     assert export.check.iou == pytest.approx(iou, abs=1e-6)
