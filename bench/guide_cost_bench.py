@@ -3,10 +3,11 @@
     python -m bench.guide_cost_bench --graphs data/zonegraphs/graphs --gt data/gt
         [--guides heuristic net=CHECKPOINT net=CHECKPOINT@top_m=8,blend=0.5,margin=0.1 ...]
         [--designs 20] [--budgets 1 5] [--seed 7] [--repeat 1] [--part tune|report]
-        [--exclude IDS.txt] [--out bench_out/guide_cost]
+        [--exclude IDS.txt] [--split test|holdout] [--min-gt 3] [--out bench_out/guide_cost]
 
-Searches the saved (simplified) zone graph of a seeded sample of test designs, stratified by
-timeline folder and none of a project any checkpoint trained on, once per guide and budget, in
+Searches the saved (simplified) zone graph of a seeded sample of test designs (or, with ``--split
+holdout``, of the training-split designs the checkpoints held out: `eval.heldout.holdout_projects`),
+stratified by timeline folder and none of a project any checkpoint trained on, once per guide and budget, in
 this one process (the ranker is made per search, then the graph is read, so a network's
 per-graph encoding counts inside the budget, as in ``zonegraph infer``). A guide
 ``net=PATH@top_m=M,blend=B`` is the `NetworkRanker` with those
@@ -31,8 +32,8 @@ import numpy as np
 import pandas as pd
 
 from eval.guides import GuideSpec
-from eval.heldout import PARTS, add_exclude, excluded, held_out, part_of, trained_projects
-from zonegraph.data.dataset import stratified_sample
+from eval.heldout import PARTS, add_exclude, excluded, held_out, holdout_projects, part_of, trained_projects
+from zonegraph.data.dataset import project_of, stratified_sample
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
@@ -48,13 +49,21 @@ def chosen_designs(
     part: str | None = None,
     part_seed: int = 0,
     exclude: Path | None = None,
+    split: str = "test",
+    min_gt: int = 0,
 ) -> pd.DataFrame:
-    """A seeded sample of ``count`` test designs with a saved graph, stratified by folder, none of a
-    project the checkpoints trained on (and of one half of them by project, with ``part``); with
-    their GT step counts."""
+    """A seeded sample of ``count`` designs of ``split`` (test, or the checkpoints' holdout) with a
+    saved graph and at least ``min_gt`` GT steps, stratified by folder, none of a project the
+    checkpoints trained on (and of one half of them by project, with ``part``); with their GT
+    step counts."""
     designs = pd.read_parquet(gt / "designs.parquet")
+    if split == "holdout":
+        held = holdout_projects(models)
+        chosen = (designs["split"] == "train") & designs["design_id"].map(lambda d: project_of(d) in held)
+    else:
+        chosen = designs["split"] == split
     designs = designs[
-        (designs["split"] == "test") & designs["design_id"].map(lambda d: (graphs / d).is_dir())
+        chosen & (designs["steps"] >= min_gt) & designs["design_id"].map(lambda d: (graphs / d).is_dir())
     ]
     seen, _ = trained_projects(models) if models else (set(), [])
     kept = part_of(excluded(held_out(designs["design_id"], seen), exclude), part, part_seed)
@@ -158,12 +167,25 @@ def main() -> None:
     parser.add_argument("--part", choices=PARTS, default=None, help="one half of the designs by project")
     parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
     add_exclude(parser)
+    parser.add_argument(
+        "--split", choices=["test", "holdout"], default="test", help="holdout: the models' held-out designs"
+    )
+    parser.add_argument("--min-gt", type=int, default=0, help="only designs of at least this many GT steps")
     parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))
     args = parser.parse_args()
     guides = [GuideSpec.parse(g) for g in args.guides]
     models = [g.checkpoint for g in guides if g.checkpoint]
     designs = chosen_designs(
-        args.gt, args.graphs, models, args.designs, args.seed, args.part, args.part_seed, args.exclude
+        args.gt,
+        args.graphs,
+        models,
+        args.designs,
+        args.seed,
+        args.part,
+        args.part_seed,
+        args.exclude,
+        args.split,
+        args.min_gt,
     )
     print(
         f"guide_cost_bench: {len(designs)} designs: {designs['folder'].value_counts().sort_index().to_dict()}"

@@ -5,6 +5,11 @@ and evaluated on another sample's test split would meet some of its own training
 the 3,100- and 3,600-design runs, 341 of 1,264 test designs). Checkpoints therefore carry the
 projects they trained and validated on (``provenance.train_projects``), and the report drops
 every design of those projects for every guide, so all guides are compared on the same designs.
+
+Once the test split is used up (every design looked at), a model trained with
+``train.holdout_fraction`` keeps a seeded share of the training split's projects out of training
+and validation (``provenance.holdout_projects``): `holdout_projects` gives the designs of those
+projects as a fresh evaluation set.
 """
 
 from __future__ import annotations
@@ -44,6 +49,31 @@ def _projects(model: Path) -> list[str] | None:
 
     provenance = torch.load(model, map_location="cpu", weights_only=True).get("provenance", {})
     return provenance.get("train_projects")
+
+
+def holdout_projects(models: Sequence[str | Path]) -> set[str]:
+    """The training-split projects that every one of ``models`` held out of its training (a
+    checkpoint's ``provenance.holdout_projects``); SystemExit naming a model that holds none out."""
+    held: set[str] | None = None
+    for model in models:
+        projects = _holdout(Path(model))
+        if not projects:
+            raise SystemExit(f"{model}: error: trained with no held-out projects (train.holdout_fraction 0)")
+        held = set(projects) if held is None else held & set(projects)
+    if held is None:
+        raise SystemExit("error: held-out designs are a network's: name one (net=CHECKPOINT)")
+    return held
+
+
+def _holdout(model: Path) -> list[str]:
+    if model.suffix == ".npz":
+        from zonegraph.network.folded import FoldedScorer
+
+        return list(FoldedScorer.load(model).holdout_projects)
+    import torch
+
+    provenance = torch.load(model, map_location="cpu", weights_only=True).get("provenance", {})
+    return list(provenance.get("holdout_projects", []))
 
 
 def held_out(design_ids: Iterable[str], projects: set[str]) -> list[str]:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import Any
 
 import torch
 
@@ -64,6 +65,7 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
         f"training states: {origin.get('train_states', '?')}",
         f"- training projects: {len(origin.get('train_projects', [])) or '?'}, listed in the checkpoint "
         "(`provenance.train_projects`): `eval.report` leaves every design of them out",
+        *holdout_line(origin),
         "",
         "## Parameters",
         "",
@@ -111,6 +113,18 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
     return "\n".join(lines) + "\n"
 
 
+def holdout_line(origin: dict[str, Any]) -> list[str]:
+    """The held-out projects' line, for a checkpoint trained with ``train.holdout_fraction``."""
+    held = origin.get("holdout_projects", [])
+    if not held:
+        return []
+    return [
+        f"- held out of training and validation: {origin.get('holdout_designs', '?')} designs of "
+        f"{len(held)} projects (`provenance.holdout_projects`), for evaluation "
+        "(`python -m bench.guide_cost_bench --split holdout`)"
+    ]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("checkpoint", type=Path)
@@ -150,3 +164,4 @@ def main() -> None:
 
 if __name__ == "__main__":
     main()
+

@@ -92,6 +92,10 @@ class TrainConfig(Config):
     points_per_zone: int = 64
     gamma: float = 0.5
     val_fraction: float = 0.15
+    # a seeded share of the training split's projects neither trained nor validated on: designs to
+    # evaluate on once the test split is used up (listed in the checkpoint, `eval.heldout`)
+    holdout_fraction: float = 0.0
+    holdout_seed: int = 0
     max_designs: int | None = None  # a seeded sample of the training designs (quick runs, costly fusions)
     seed: int = 0
     device: str = "cpu"  # cpu, cuda, or auto (cuda when available)
@@ -121,6 +125,8 @@ class TrainConfig(Config):
             raise SystemExit("train: a teacher shares the listwise target: loss listwise, distill in [0, 1]")
         if self.teacher is not None and not Path(self.teacher).is_file():
             raise SystemExit(f"train: {self.teacher}: no teacher checkpoint")
+        if not 0.0 <= self.holdout_fraction < 1.0:
+            raise SystemExit("train: holdout_fraction is a share of the training projects, in [0, 1)")
         if self.device == "cuda" and not torch.cuda.is_available():
             raise SystemExit("train: --device cuda, but torch finds no CUDA device (use cpu or auto)")
 
@@ -305,11 +311,24 @@ def labelled_designs(labels_dir: str | Path, split: str) -> list[str]:
     return sorted(set(chosen))
 
 
-def split_designs(labels_dir: str | Path, seed: int, fraction: float) -> tuple[list[str], list[str]]:
-    """Training-split designs with labels, split by project into training and validation."""
-    ids = labelled_designs(labels_dir, "train")
-    val = test_ids(ids, seed, fraction)
-    return [i for i in ids if i not in val], sorted(val)
+@dataclass(frozen=True)
+class DesignSplit:
+    """The labelled training-split designs of one run, by project: trained on, validated on (the
+    best epoch's pick) and held out of both (for evaluation)."""
+
+    train: list[str]
+    val: list[str]
+    holdout: list[str]
+
+
+def split_designs(config: TrainConfig) -> DesignSplit:
+    """The labelled training-split designs split by project: the holdout first (its own seed, so
+    that it stays the same whatever the validation seed), then validation from the rest."""
+    ids = labelled_designs(config.labels_dir, "train")
+    held = test_ids(ids, config.holdout_seed, config.holdout_fraction) if config.holdout_fraction else set()
+    rest = [i for i in ids if i not in held]
+    val = test_ids(rest, config.seed, config.val_fraction)
+    return DesignSplit([i for i in rest if i not in val], sorted(val), sorted(held))
 
 
 def resume_key(config: TrainConfig, version: str) -> dict[str, Any]:
@@ -384,7 +403,8 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     torch.manual_seed(config.seed)
     np.random.seed(config.seed)
     device = pick_device(config.device)
-    train_ids, val_ids = split_designs(config.labels_dir, config.seed, config.val_fraction)
+    split = split_designs(config)
+    train_ids, val_ids = split.train, split.val
     if config.max_designs is not None and config.max_designs < len(train_ids):
         keep = np.random.default_rng(config.seed).choice(len(train_ids), config.max_designs, replace=False)
         train_ids = [train_ids[i] for i in sorted(keep)]
@@ -396,6 +416,12 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     val_loader = DataLoader(sets["val"], batch_size=config.batch_states)
     model = ProposalScorer(config.model).to(device)
     teacher, taught = load_teacher(config, device)
+    holdout = sorted({project_of(d) for d in split.holdout})
+    if set(taught) & set(holdout):
+        raise SystemExit(
+            f"train: {config.teacher}: the teacher trained on {len(set(taught) & set(holdout))} of the "
+            "held-out projects: train it with the same holdout_fraction and holdout_seed"
+        )
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
     out = Path(config.out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -423,6 +449,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
         sizes = {
             "train_designs": len(train_ids),
             "val_designs": len(val_ids),
+            "holdout_designs": len(split.holdout),
             "train_states": len(sets["train"]),
         }
         tags = {"data_version": version, "git_commit": git_commit()}
@@ -435,6 +462,8 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
             mlflow.set_tags(resumed)
         seen = sorted({project_of(d) for d in [*train_ids, *val_ids]} | set(taught))  # evaluation skips these
         provenance = {**sizes, **tags, "run_id": run.info.run_id, "train_projects": seen}
+        if holdout:
+            provenance["holdout_projects"] = holdout
         for epoch in range(first, config.epochs + 1):
             t0 = time.perf_counter()
             model.train()

@@ -49,12 +49,16 @@ def guide_settings(checkpoint: dict[str, Any]) -> tuple[int | None, dict[str, An
 
 
 def fold_checkpoint(checkpoint: dict[str, Any]) -> FoldedScorer:
-    """A late-fusion checkpoint's scorer as numpy arrays, with its `guide_settings` and the
-    projects it trained on."""
+    """A late-fusion checkpoint's scorer as numpy arrays, with its `guide_settings`, the projects
+    it trained on and those it held out."""
     samples, search = guide_settings(checkpoint)
-    projects = tuple(checkpoint.get("provenance", {}).get("train_projects", ()))
+    provenance = checkpoint.get("provenance", {})
     return replace(
-        fold(scorer_from(checkpoint)), points_per_zone=samples, search=search, train_projects=projects
+        fold(scorer_from(checkpoint)),
+        points_per_zone=samples,
+        search=search,
+        train_projects=tuple(provenance.get("train_projects", ())),
+        holdout_projects=tuple(provenance.get("holdout_projects", ())),
     )
 
 

@@ -96,6 +96,7 @@ class FoldedScorer:
     points_per_zone: int | None = None  # the surface samples per zone it was trained with
     search: dict[str, Any] = field(default_factory=dict)  # the guide's defaults (top_m, blend)
     train_projects: tuple[str, ...] = ()  # the projects it saw in training: evaluation skips them
+    holdout_projects: tuple[str, ...] = ()  # training-split projects it never saw, kept for evaluation
 
     def encode_geometry(self, points: np.ndarray) -> np.ndarray | None:
         """(Z, H) each zone's geometry as it enters ``zone_in``'s first layer (its PointNet code
@@ -197,12 +198,14 @@ class FoldedScorer:
             "points_per_zone": self.points_per_zone,
             "search": self.search,
         }
-        np.savez(
-            path,
-            meta=np.array(json.dumps(meta, sort_keys=True)),
-            weights=np.concatenate(flat) if flat else np.zeros(0, np.float32),
-            train_projects=np.array(self.train_projects, dtype=str),
-        )
+        members: dict[str, Any] = {
+            "meta": np.array(json.dumps(meta, sort_keys=True)),
+            "weights": np.concatenate(flat) if flat else np.zeros(0, np.float32),
+            "train_projects": np.array(self.train_projects, dtype=str),
+        }
+        if self.holdout_projects:  # older files, and models with no holdout, have no such member
+            members["holdout_projects"] = np.array(self.holdout_projects, dtype=str)
+        np.savez(path, **members)
 
     @staticmethod
     def header(path: str | Path) -> dict[str, Any]:
@@ -240,6 +243,7 @@ class FoldedScorer:
             # their own member, so that a guide reads a small header (older files: in the header)
             own = "train_projects" in data.files
             names = (data["train_projects"] if own else meta.get("train_projects", ())) if projects else ()
+            held = data["holdout_projects"] if projects and "holdout_projects" in data.files else ()
             chains = {
                 name: tuple(
                     tuple(
@@ -262,6 +266,7 @@ class FoldedScorer:
             points_per_zone=meta["points_per_zone"],
             search=meta["search"],
             train_projects=tuple(str(p) for p in names),
+            holdout_projects=tuple(str(p) for p in held),
         )
 
     def _chains(self) -> dict[str, tuple[Chain, ...]]:
