@@ -401,3 +401,44 @@ def test_a_stopped_run_resumes_from_its_last_epoch_in_the_same_mlflow_run(labell
     assert json.loads((tmp_path / "broken" / "best.json").read_text())["run_id"] == broken["run_id"]
     train(replace(base, out_dir="broken", lr=0.01), fresh=False)  # other settings: a new run
     assert torch.load(tmp_path / "broken" / "last.pt", weights_only=True)["run_id"] != broken["run_id"]
+
+
+@requires_samples
+def test_a_holdout_of_training_projects_is_never_trained_on_and_is_what_the_bench_searches(
+    labelled, tmp_path, monkeypatch
+):
+    import pandas as pd
+
+    from bench.guide_cost_bench import chosen_designs
+    from eval.heldout import holdout_projects
+    from zonegraph.network.checkpoint import fold_checkpoint, read_checkpoint
+    from zonegraph.network.folded import FoldedScorer
+
+    monkeypatch.chdir(tmp_path)
+    config = _quick(labelled, out_dir="held", loss="listwise", use_points=False)
+    train(replace(config, holdout_fraction=0.34, holdout_seed=5))
+    checkpoint = read_checkpoint(tmp_path / "held" / "scorer.pt")
+    provenance = checkpoint["provenance"]
+    everything = {project_of(d.stem) for d in (labelled / "graphs").iterdir()}
+    held, seen = set(provenance["holdout_projects"]), set(provenance["train_projects"])
+    assert len(held) == 1 and not held & seen and held | seen == everything
+    assert provenance["holdout_designs"] == 1 and "held out of training" in card(checkpoint, tmp_path)
+    fold_checkpoint(checkpoint).save(tmp_path / "held.npz")
+    assert FoldedScorer.load(tmp_path / "held.npz").holdout_projects == tuple(held)
+    assert holdout_projects([tmp_path / "held.npz"]) == held
+
+    designs = sorted(d.name for d in (labelled / "graphs").iterdir())
+    gt = tmp_path / "gt"
+    gt.mkdir()
+    table = {"design_id": designs, "split": "train", "folder": "samples", "steps": 2}
+    pd.DataFrame(table).to_parquet(gt / "designs.parquet")
+    chosen = chosen_designs(gt, labelled / "graphs", [str(tmp_path / "held.npz")], 10, 0, split="holdout")
+    assert [project_of(d) for d in chosen["design_id"]] == sorted(held)
+    assert chosen_designs(gt, labelled / "graphs", [], 10, 0, min_gt=3).empty
+
+    train(replace(config, out_dir="whole"))  # no holdout: nothing to evaluate on, said in one line
+    with pytest.raises(SystemExit, match="no held-out projects"):
+        holdout_projects([tmp_path / "whole" / "scorer.pt"])
+    taught = replace(config, out_dir="student", teacher=str(tmp_path / "whole" / "scorer.pt"))
+    with pytest.raises(SystemExit, match="teacher trained on 1 of the held-out projects"):
+        train(replace(taught, holdout_fraction=0.34, holdout_seed=5))
