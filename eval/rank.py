@@ -26,7 +26,16 @@ import pandas as pd
 import pyarrow.dataset as ds
 
 from eval.guides import GuideSpec
-from eval.heldout import PARTS, add_exclude, excluded, held_out_labelled, part_of, trained_projects
+from eval.heldout import (
+    PARTS,
+    add_exclude,
+    excluded,
+    held_out_labelled,
+    holdout_projects,
+    part_of,
+    trained_projects,
+)
+from zonegraph.data.dataset import project_of
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.sequence.rankers import GTPlace, Ranker, gt_place, make_ranker, score_step
 from zonegraph.zones.model import ZoneGraph
@@ -387,7 +396,9 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--labels", type=Path, default=Path("data/labels"))
     parser.add_argument("--graphs", type=Path, default=Path("data/zonegraphs/graphs"))
-    parser.add_argument("--split", default="test")
+    parser.add_argument(
+        "--split", default="test", help="a labels split, or holdout: the training projects models held out"
+    )
     parser.add_argument("--guides", nargs="*", default=["random", "heuristic"])
     parser.add_argument("--model", nargs="*", default=[], help="network checkpoints to rank with")
     parser.add_argument("--limit", type=int, default=None, help="the first N designs (by id) only")
@@ -417,12 +428,17 @@ def main(argv: list[str] | None = None) -> None:
         ranks = earlier[earlier["design_id"].isin(part_of(kept, args.part, args.part_seed)[: args.limit])]
         print(f"rank: {ranks['design_id'].nunique()} designs of {args.ranks}", flush=True)
     else:
-        seen, _ = trained_projects([GuideSpec.parse(f"net={m}").model or "" for m in args.model])
-        kept = excluded(held_out_labelled(args.labels, args.split, seen), args.exclude)
+        models = [GuideSpec.parse(f"net={m}").model or "" for m in args.model]
+        seen, _ = trained_projects(models)
+        split = "train" if args.split == "holdout" else args.split
+        kept = excluded(held_out_labelled(args.labels, split, seen), args.exclude)
+        if args.split == "holdout":
+            held = holdout_projects(models)
+            kept = [d for d in kept if project_of(d) in held]
         designs = part_of(kept, args.part, args.part_seed)[: args.limit]
         print(f"rank: {len(designs)} {args.split} designs of no project a model trained on", flush=True)
         guides = make_guides(args.guides, args.model, args.seed)
-        ranks = guide_ranks(args.labels, args.graphs, guides, args.split, designs)
+        ranks = guide_ranks(args.labels, args.graphs, guides, split, designs)
     if ranks.empty:
         raise SystemExit("rank: error: no designs left to rank")
     table = summarise(ranks, seed=args.seed)

@@ -411,6 +411,7 @@ def test_a_holdout_of_training_projects_is_never_trained_on_and_is_what_the_benc
 
     from bench.guide_cost_bench import chosen_designs
     from eval.heldout import holdout_projects
+    from eval.rank import main as rank_main
     from zonegraph.network.checkpoint import fold_checkpoint, read_checkpoint
     from zonegraph.network.folded import FoldedScorer
 
@@ -435,6 +436,12 @@ def test_a_holdout_of_training_projects_is_never_trained_on_and_is_what_the_benc
     chosen = chosen_designs(gt, labelled / "graphs", [str(tmp_path / "held.npz")], 10, 0, split="holdout")
     assert [project_of(d) for d in chosen["design_id"]] == sorted(held)
     assert chosen_designs(gt, labelled / "graphs", [], 10, 0, min_gt=3).empty
+    rank_main(
+        ["--labels", str(labelled / "labels"), "--graphs", str(labelled / "graphs"), "--split", "holdout"]
+        + ["--guides", "heuristic", "--model", str(tmp_path / "held.npz"), "--out", str(tmp_path / "rank")]
+    )
+    ranked = pd.read_parquet(tmp_path / "rank" / "ranks.parquet")
+    assert {project_of(d) for d in ranked["design_id"]} == held
 
     train(replace(config, out_dir="whole"))  # no holdout: nothing to evaluate on, said in one line
     with pytest.raises(SystemExit, match="no held-out projects"):
