@@ -24,6 +24,7 @@ import pyarrow.dataset as ds
 from zonegraph.data.dataset import project_of
 
 PARTS = ("tune", "report")
+HOLDOUT = "holdout"  # the designs a model held out of training, where a split is named
 
 
 def trained_projects(models: Sequence[str | Path]) -> tuple[set[str], list[str]]:

@@ -34,7 +34,15 @@ import pandas as pd
 import zonegraph.network
 from eval.curves import at_time, curves, plot_curves, time_grid
 from eval.dvc_metrics import rounded, write_guides
-from eval.heldout import add_exclude, excluded, held_out, held_out_labelled, trained_projects
+from eval.heldout import (
+    HOLDOUT,
+    add_exclude,
+    excluded,
+    held_out,
+    held_out_labelled,
+    holdout_projects,
+    trained_projects,
+)
 from eval.programs import program_measures
 from eval.rank import (
     design_folders,
@@ -49,6 +57,7 @@ from eval.rank import (
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
 from eval.strips import pick_designs, write_strips
 from zonegraph.configs import Config, ConfigError, InferConfig, load_section
+from zonegraph.data.dataset import project_of
 
 SHIPPED = Path(zonegraph.network.__file__).resolve().parent / "checkpoints" / "scorer.pt"  # no torch import
 MARKS = (1.0, 5.0, 20.0)  # seconds at which IoU and exact rate are reported as metrics
@@ -140,14 +149,26 @@ def searches_for(
     return out
 
 
+def split_of(args: argparse.Namespace) -> str:
+    """The pipeline split ``--designs`` names: the held-out designs are of the training split."""
+    return "train" if args.designs == HOLDOUT else str(args.designs)
+
+
+def evaluated(args: argparse.Namespace, design_ids: list[str]) -> list[str]:
+    """``design_ids`` of no project a model trained on, less ``--exclude``, and with ``--designs
+    holdout`` only those of the projects the models held out."""
+    kept = excluded(held_out(design_ids, args.trained), args.exclude)
+    return kept if args.held is None else [d for d in kept if project_of(d) in args.held]
+
+
 def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tuple[pd.DataFrame, str]:
     labels, graphs = Path(args.labels), Path(args.graphs)
     if not (labels / "proposals").is_dir() or Path(args.designs).is_dir():
         return pd.DataFrame(), "No rank-only labels for these designs: the rank needs the labels stage.\n"
     rankers = make_guides(["random", "heuristic"], [g.model for g in guides if g.model], args.seed)
     rankers = {g.name: r for g, r in zip(guides, rankers.values(), strict=True)}
-    designs = excluded(held_out_labelled(labels, args.designs, args.trained), args.exclude)[: args.limit]
-    ranks = guide_ranks(labels, graphs, rankers, args.designs, designs)
+    designs = evaluated(args, held_out_labelled(labels, split_of(args), set()))
+    ranks = guide_ranks(labels, graphs, rankers, split_of(args), designs[: args.limit])
     ranks.to_parquet(out / "ranks.parquet", index=False)
     table = summarise(ranks, seed=args.seed)
     ratio = ratios(ranks, seed=args.seed)
@@ -188,9 +209,9 @@ def search_section(
     targets = (
         folder_targets(args.designs)
         if Path(args.designs).is_dir()
-        else split_targets(args.designs, args.project)
+        else split_targets(split_of(args), args.project)
     )
-    kept = set(excluded(held_out([t.design_id for t in targets], args.trained), args.exclude))
+    kept = set(evaluated(args, [t.design_id for t in targets]))
     targets = [
         t
         for t in targets
@@ -360,7 +381,9 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", nargs="*", default=d["model"], help="network checkpoints to evaluate")
     parser.add_argument(
-        "--designs", default=d["designs"], help="a split of the project, or a folder of parts"
+        "--designs",
+        default=d["designs"],
+        help=f"a split of the project, {HOLDOUT} (the projects models held out of training), or a folder",
     )
     parser.add_argument(
         "--budget", dest="budget_s", type=float, default=d["budget_s"], help="search seconds per design"
@@ -417,6 +440,7 @@ def main() -> None:
         print(f"report: warning: {model} does not list its training projects; they cannot be held out")
     if args.trained:
         print(f"report: leaving out the designs of the {len(args.trained)} projects the models trained on")
+    args.held = holdout_projects(args.model) if args.designs == HOLDOUT else None
     guides = guides_for(args.model)
     rank, rank_text = rank_section(args, guides, args.out)
     results, curve_table, search_text = search_section(args, guides, args.out)
@@ -433,7 +457,7 @@ def main() -> None:
         wide.rename(columns=lambda c: str(c).replace(":", "_")).to_csv(args.plot_csv, index=False)
     print(report.split("\n## Coverage")[0])
     if not args.no_mlflow:
-        params = {k: v for k, v in vars(args).items() if k not in ("no_mlflow", "trained")}
+        params = {k: v for k, v in vars(args).items() if k not in ("no_mlflow", "trained", "held")}
         params["excluded_training_projects"] = len(args.trained)
         from eval.tracking import log_evaluation
 

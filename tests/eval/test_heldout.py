@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import pytest
 
-from eval.heldout import part_of, trained_projects
+from eval.heldout import HOLDOUT, part_of, trained_projects
 from zonegraph.network.checkpoint import SHIPPED
 from zonegraph.network.folded import SHIPPED_FOLDED
 
@@ -34,3 +37,24 @@ def test_listed_designs_are_left_out_and_a_missing_list_is_one_line(tmp_path):
     assert excluded(["10_a_0000"], None) == ["10_a_0000"]
     with pytest.raises(SystemExit, match="missing.txt: error: no such list of design ids"):
         excluded(["10_a_0000"], tmp_path / "missing.txt")
+
+
+def test_a_report_on_held_out_designs_keeps_those_projects_and_needs_a_model_that_held_some_out(tmp_path):
+    from argparse import Namespace
+
+    from eval.report import evaluated, split_of
+
+    ids = ["1_a_0000", "1_a_0001", "2_b_0000", "3_c_0000", "4_d_0000"]
+    args = Namespace(designs=HOLDOUT, trained={"1_a"}, exclude=None, held={"1_a", "2_b", "3_c"})
+    assert split_of(args) == "train" and evaluated(args, ids) == ["2_b_0000", "3_c_0000"]
+    split = Namespace(designs="test", trained={"1_a"}, exclude=None, held=None)
+    assert evaluated(split, ids) == ids[2:]
+    shipped = str(SHIPPED_FOLDED)  # trained on the whole training split
+    command = ["-m", "eval.report", "--designs", HOLDOUT, "--model", shipped, "--out", str(tmp_path)]
+    done = subprocess.run(
+        [sys.executable, *command],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode != 0 and "Traceback" not in done.stderr
+    assert done.stderr.strip().endswith("trained with no held-out projects (train.holdout_fraction 0)")
