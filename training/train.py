@@ -35,6 +35,7 @@ import socket
 import subprocess
 import threading
 import time
+import zlib
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -322,13 +323,20 @@ class DesignSplit:
 
 
 def split_designs(config: TrainConfig) -> DesignSplit:
-    """The labelled training-split designs split by project: the holdout first (its own seed, so
-    that it stays the same whatever the validation seed), then validation from the rest."""
+    """The labelled training-split designs split by project: the holdout first, then validation
+    from the rest."""
     ids = labelled_designs(config.labels_dir, "train")
-    held = test_ids(ids, config.holdout_seed, config.holdout_fraction) if config.holdout_fraction else set()
+    held = {i for i in ids if held_out_project(project_of(i), config.holdout_seed, config.holdout_fraction)}
     rest = [i for i in ids if i not in held]
     val = test_ids(rest, config.seed, config.val_fraction)
     return DesignSplit([i for i in rest if i not in val], sorted(val), sorted(held))
+
+
+def held_out_project(project: str, seed: int, fraction: float) -> bool:
+    """Whether ``project`` is in the holdout drawn with ``seed``: a seeded hash of its name, so a
+    project is held out or not whatever labels it is read from, and a teacher and its student
+    trained on different label sets hold out the same projects."""
+    return zlib.crc32(f"{seed}/{project}".encode()) < fraction * 2**32
 
 
 def resume_key(config: TrainConfig, version: str) -> dict[str, Any]:
