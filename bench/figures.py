@@ -285,6 +285,8 @@ def guide_cost_figure(results: dict, reference: str = "heuristic") -> dict:
             "designs": int(r["designs"]),
             "exact_gt3": int(r["exact_gt3"]),
             "designs_gt3": int(r["designs_gt3"]),
+            "mean_iou": _rounded(r["mean_iou"], 4),
+            "mean_iou_gt3": _rounded(r["mean_iou_gt3"], 4),
             "median_time_to_exact_s": _rounded(r["median_time_to_exact_s"], 5),
             "median_expansions": _rounded(r["median_expansions"], 1),
             "time_ratio": None if r["guide"] == reference else _median_ratio(times, r["guide"], reference),

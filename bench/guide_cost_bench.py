@@ -110,8 +110,8 @@ def fastest(
 
 
 def summary(rows: pd.DataFrame) -> pd.DataFrame:
-    """Per guide and budget: exact counts over designs (all, GT >= 3) and median time to exact on
-    the designs every guide solved at that budget."""
+    """Per guide and budget: exact counts and mean zone IoU of the best canvas over designs (all,
+    GT >= 3) and median time to exact on the designs every guide solved at that budget."""
     out = []
     for budget, at in rows.groupby("budget"):
         solved = at.groupby("design_id")["exact"].all()
@@ -127,6 +127,8 @@ def summary(rows: pd.DataFrame) -> pd.DataFrame:
                     "designs": len(group),
                     "exact_gt3": int(long["exact"].sum()),
                     "designs_gt3": len(long),
+                    "mean_iou": _mean_iou(group),
+                    "mean_iou_gt3": _mean_iou(long),
                     "common": len(both),
                     "median_time_to_exact_s": float(np.median(both["time_to_exact_s"]))
                     if len(both)
@@ -136,6 +138,11 @@ def summary(rows: pd.DataFrame) -> pd.DataFrame:
                 }
             )
     return pd.DataFrame(out)
+
+
+def _mean_iou(rows: pd.DataFrame) -> float | None:
+    """Mean zone IoU of the best canvases (None for no rows, or rows written before it was kept)."""
+    return float(rows["iou"].mean()) if len(rows) and "iou" in rows else None
 
 
 def markdown(table: pd.DataFrame) -> str:

@@ -283,9 +283,9 @@ def replay(records: list[dict]) -> str:
 def guide_cost(records: list[dict]) -> str:
     """Searches by guide at equal budgets: exact, and the time to exact against the reference's."""
     lines = [
-        "| run | budget s | guide | exact | exact, GT >= 3 | median s to exact (all solve) | "
-        "median expansions | median time / reference's (90% CI, designs) |",
-        "|---|---|---|---|---|---|---|---|",
+        "| run | budget s | guide | exact | exact, GT >= 3 | mean IoU (all / GT >= 3) | "
+        "median s to exact (all solve) | median expansions | median time / reference's (90% CI, designs) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in records:
         figure = r["figure"]
@@ -299,15 +299,24 @@ def guide_cost(records: list[dict]) -> str:
                 expansions = "-" if g["median_expansions"] is None else f"{g['median_expansions']:g}"
                 lines.append(
                     f"| {r['name']} | {budget} | {guide} | {_rate(g['exact'], g['designs'])} | "
-                    f"{_rate(g['exact_gt3'], g['designs_gt3'])} | {median} | {expansions} | {versus} |"
+                    f"{_rate(g['exact_gt3'], g['designs_gt3'])} | {_ious(g)} | {median} | {expansions} | "
+                    f"{versus} |"
                 )
     reference = ", ".join(sorted({r["figure"]["reference"] for r in records}))
     note = (
         f"\n\nThe last column: the guide's median time to exact over the {reference}'s, on the designs "
         "both solved at that budget. Medians of time and expansions: over the designs every guide of "
-        "the run solved."
+        "the run solved. Mean IoU: the zone IoU of each search's best canvas at that budget."
     )
     return "\n".join(lines) + note + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def _ious(guide: dict) -> str:
+    """Mean zone IoU of all designs and of GT >= 3 (figures measured before it carry none)."""
+    if guide.get("mean_iou") is None:
+        return "-"
+    long = guide.get("mean_iou_gt3")
+    return f"{guide['mean_iou']:.3f} / " + ("-" if long is None else f"{long:.3f}")
 
 
 def report(records: list[dict]) -> str:

@@ -255,6 +255,7 @@ def test_the_guide_cost_figure_compares_each_guide_on_the_designs_both_solved():
             "time_to_exact_s": seconds if exact else None,
             "search_cpu_s": 0.01,
             "expansions": 2,
+            "iou": 1.0 if exact else 0.5,
         }
 
     rows = [
@@ -270,6 +271,7 @@ def test_the_guide_cost_figure_compares_each_guide_on_the_designs_both_solved():
     assert at["common"] == 2
     net, heuristic = at["guides"]["net"], at["guides"]["heuristic"]
     assert (net["exact"], net["exact_gt3"], net["designs_gt3"]) == (3, 2, 2)
+    assert (heuristic["mean_iou"], heuristic["mean_iou_gt3"], net["mean_iou"]) == (0.8333, 0.75, 1.0)
     assert heuristic["exact"] == 2 and heuristic["time_ratio"] is None
     assert net["median_time_to_exact_s"] == 0.0025 and heuristic["median_time_to_exact_s"] == 0.003
     assert net["time_ratio"]["designs"] == 2 and net["time_ratio"]["ratio"] == round(0.0025 / 0.003, 3)
@@ -277,7 +279,7 @@ def test_the_guide_cost_figure_compares_each_guide_on_the_designs_both_solved():
     assert low <= net["time_ratio"]["ratio"] <= high
     record = {"name": "run", "command": "python -m bench.guide_cost_bench", "commit": "abc1234"}
     table = _hook().guide_cost([record | {"measured": "2026-12-05", "figure": figure}])
-    assert "| run | 1 | net | 3/3 (100.0%) | 2/2 (100.0%) | 0.0025 | 2 | 0.83 (" in table
+    assert "| run | 1 | net | 3/3 (100.0%) | 2/2 (100.0%) | 1.000 / 1.000 | 0.0025 | 2 | 0.83 (" in table
 
 
 def test_the_report_figure_reads_each_curve_at_the_last_point_before_each_time(tmp_path):
