@@ -297,8 +297,13 @@ def log_scorer(path: Path) -> None:
 
 
 def git_commit() -> str:
+    """The commit of the training code, wherever training runs from (a run in a folder outside
+    the repository recorded ``unknown``); ``unknown`` outside a git checkout."""
+    here = Path(__file__).resolve().parent
     try:
-        out = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, check=True)
+        out = subprocess.run(
+            ["git", "rev-parse", "HEAD"], capture_output=True, text=True, check=True, cwd=here
+        )
         return out.stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return "unknown"

@@ -449,3 +449,13 @@ def test_a_holdout_of_training_projects_is_never_trained_on_and_is_what_the_benc
     taught = replace(config, out_dir="student", teacher=str(tmp_path / "whole" / "scorer.pt"))
     with pytest.raises(SystemExit, match="teacher trained on 1 of the held-out projects"):
         train(replace(taught, holdout_fraction=0.34, holdout_seed=5))
+
+
+def test_a_run_records_the_commit_of_its_code_wherever_it_runs_from(tmp_path, monkeypatch):
+    import subprocess
+
+    from training.train import git_commit
+
+    head = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, check=True)
+    monkeypatch.chdir(tmp_path)  # no git checkout here
+    assert git_commit() == head.stdout.strip()
