@@ -13,7 +13,15 @@ from pathlib import Path
 from zonegraph.sequence.rankers import Ranker, make_ranker
 
 # NetworkRanker's keyword arguments
-KNOBS = {"top_m": int, "blend": float, "margin": float, "defer": int, "wake": int, "relay": int}
+KNOBS = {
+    "top_m": int,
+    "blend": float,
+    "margin": float,
+    "defer": int,
+    "wake": int,
+    "relay": int,
+    "calls": int,
+}
 
 
 @dataclass(frozen=True)

@@ -306,3 +306,26 @@ def test_the_layers_are_one_member_and_files_of_one_member_per_array_still_load(
 
 def _layers(scorer: FoldedScorer) -> list:
     return [layer for chains in scorer._chains().values() for chain in chains for layer in chain]
+
+
+@requires_samples
+def test_a_guide_with_a_call_budget_takes_the_heuristics_order_once_it_is_spent(states):
+    graph, canvas, proposals = states[0]
+    heuristic = np.argsort(-HeuristicRanker().score(graph, canvas, proposals), kind="stable").tolist()
+
+    def eager(step: int) -> list[int]:
+        scores = NetworkRanker().score_at(graph, canvas, proposals, step)
+        return [int(i) for i in np.argsort(-scores, kind="stable")][:5]
+
+    assert eager(1) != heuristic[:5], "the network's order is the heuristic's: the test tells nothing"
+    ranker = NetworkRanker(defer=False, calls=2)
+    calls = []
+    scorer_score = ranker.scorer.score
+    ranker.scorer.score = lambda *args: calls.append(1) or scorer_score(*args)  # type: ignore[method-assign]
+    assert list(ranker.order_at(graph, canvas, proposals, 0, 5)) == eager(0)
+    assert list(ranker.order_at(graph, canvas, proposals, 1, 5)) == eager(1) and len(calls) == 2
+    assert list(ranker.order_at(graph, canvas, proposals, 1, 5)) == heuristic[:5] and len(calls) == 2
+    assert list(ranker.order_at(graph, canvas, proposals, 0, 5)) == eager(0), "a new search scores again"
+    deferring = NetworkRanker(defer=True, calls=0)  # the heuristic's order throughout: no call at all
+    assert list(deferring.order_at(graph, canvas, proposals, 0, 5)) == heuristic[:5]
+    assert not deferring.scorer.loaded

@@ -25,7 +25,11 @@ heuristic's order alone (no network call) and, after N expansions without the ta
 second walk from the empty canvas in the network's order (every state scored), the two walks
 taking turns (`zonegraph.sequence.best_first.search`): a design the heuristic solves within N
 expansions costs what the heuristic's search does, and a wrong first choice near the root, which
-backtracking deep in its subtree does not undo within a budget, is not the only way left. A
+backtracking deep in its subtree does not undo within a budget, is not the only way left. ``calls``
+N lets the network score at most N states of one search, the rest taking the heuristic's order: a
+network call costs a few heuristic expansions, so a search that backtracks through thousands of
+states without finding the target (where neither order solves the design) makes the heuristic's
+progress after the first N instead of a fraction of it. A
 checkpoint may carry its own defaults (its ``search`` entry); the arguments override them. A state
 where a proposal completes the target never reaches a ranker in search
 (`zonegraph.sequence.best_first` takes that step unscored), so where the guide is asked to rank
@@ -181,6 +185,7 @@ class NetworkRanker:
         defer: bool | None = None,
         wake: bool | None = None,
         relay: int | None = None,
+        calls: int | None = None,
     ) -> None:
         path = Path(model) if model else SHIPPED_FOLDED
         if not path.is_file():
@@ -194,6 +199,8 @@ class NetworkRanker:
         self.defer = bool(defer if defer is not None else search.get("defer", False))
         self.wake = bool(wake if wake is not None else search.get("wake", False))
         self.relay_after: int | None = (relay if relay is not None else search.get("relay")) or None
+        self.calls: int | None = calls if calls is not None else search.get("calls")
+        self._made = 0  # network calls of the current search
         self._woken: ZoneGraph | None = None  # the graph in whose search the network took over
         self._heuristic = HeuristicRanker()
         self._graph: ZoneGraph | None = None
@@ -222,13 +229,23 @@ class NetworkRanker:
         every state of a graph is ordered by `score_at` once the search has backtracked in it;
         with ``relay`` by the heuristic (the network orders the search's second walk)."""
         if step == 0:  # a search's first state: a new search, asleep again
-            self._woken = None
+            self._woken, self._made = None, 0
+        if not proposals:
+            return iter(())
         if self.relay_after:  # the first walk of a relay: the heuristic's order
             return iter(best_first(self._heuristic.score(graph, canvas, proposals))[:k])
-        if not self.defer or self._woken is graph:
-            return iter(best_first(self.score_at(graph, canvas, proposals, step))[:k])
         heuristic = self._heuristic.score(graph, canvas, proposals)
+        if not self.defer or self._woken is graph:
+            if not self._charge():
+                return iter(best_first(heuristic)[:k])
+            return iter(best_first(self._scored(heuristic, graph, canvas, proposals, step))[:k])
         return self._after(heuristic, graph, canvas, proposals, step, k)
+
+    def _charge(self) -> bool:
+        """Whether the network may score one more state of the current search (``calls``);
+        counts the call."""
+        self._made += 1
+        return self.calls is None or self._made <= self.calls
 
     def _after(
         self,
@@ -246,7 +263,8 @@ class NetworkRanker:
         if self.wake:
             self._woken = graph
         if k > 1 and len(proposals) > 1:
-            scores = self._scored(heuristic, graph, canvas, proposals, step)
+            charged = self._charge()
+            scores = self._scored(heuristic, graph, canvas, proposals, step) if charged else heuristic
             yield from [i for i in best_first(scores) if i != first][: k - 1]
 
     def score_at(
