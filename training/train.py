@@ -35,7 +35,6 @@ import socket
 import subprocess
 import threading
 import time
-import zlib
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -340,8 +339,11 @@ def split_designs(config: TrainConfig) -> DesignSplit:
 def held_out_project(project: str, seed: int, fraction: float) -> bool:
     """Whether ``project`` is in the holdout drawn with ``seed``: a seeded hash of its name, so a
     project is held out or not whatever labels it is read from, and a teacher and its student
-    trained on different label sets hold out the same projects."""
-    return zlib.crc32(f"{seed}/{project}".encode()) < fraction * 2**32
+    trained on different label sets hold out the same projects. SHA-256, since a CRC is linear:
+    two seeds' CRCs of a name differ by a constant, so their draws were not independent (two 15%
+    holdouts shared no project)."""
+    digest = hashlib.sha256(f"{seed}/{project}".encode()).digest()
+    return int.from_bytes(digest[:8], "big") < fraction * 2**64
 
 
 def resume_key(config: TrainConfig, version: str) -> dict[str, Any]:

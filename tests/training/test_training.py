@@ -417,7 +417,7 @@ def test_a_holdout_of_training_projects_is_never_trained_on_and_is_what_the_benc
 
     monkeypatch.chdir(tmp_path)
     config = _quick(labelled, out_dir="held", loss="listwise", use_points=False)
-    train(replace(config, holdout_fraction=0.34, holdout_seed=5))
+    train(replace(config, holdout_fraction=0.34, holdout_seed=3))
     checkpoint = read_checkpoint(tmp_path / "held" / "scorer.pt")
     provenance = checkpoint["provenance"]
     everything = {project_of(d.stem) for d in (labelled / "graphs").iterdir()}
@@ -448,7 +448,7 @@ def test_a_holdout_of_training_projects_is_never_trained_on_and_is_what_the_benc
         holdout_projects([tmp_path / "whole" / "scorer.pt"])
     taught = replace(config, out_dir="student", teacher=str(tmp_path / "whole" / "scorer.pt"))
     with pytest.raises(SystemExit, match="teacher trained on 1 of the held-out projects"):
-        train(replace(taught, holdout_fraction=0.34, holdout_seed=5))
+        train(replace(taught, holdout_fraction=0.34, holdout_seed=3))
 
 
 def test_a_run_records_the_commit_of_its_code_wherever_it_runs_from(tmp_path, monkeypatch):
@@ -459,3 +459,15 @@ def test_a_run_records_the_commit_of_its_code_wherever_it_runs_from(tmp_path, mo
     head = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, check=True)
     monkeypatch.chdir(tmp_path)  # no git checkout here
     assert git_commit() == head.stdout.strip()
+
+
+def test_holdouts_drawn_with_two_seeds_are_independent_draws_of_about_their_share():
+    from training.train import held_out_project
+
+    rng = np.random.default_rng(0)
+    projects = [f"{rng.integers(10**5)}_{rng.integers(2**32):08x}" for _ in range(4000)]
+    first = {p for p in projects if held_out_project(p, 2718, 0.15)}
+    second = {p for p in projects if held_out_project(p, 3737, 0.15)}
+    assert 0.13 < len(first) / len(projects) < 0.17 and 0.13 < len(second) / len(projects) < 0.17
+    expected = len(first) * len(second) / len(projects)  # a CRC's draws shared none
+    assert 0.6 * expected < len(first & second) < 1.4 * expected
