@@ -98,7 +98,8 @@ def card(checkpoint: dict, path: Path, test_ranks: dict | None = None, note: str
             "only those within that much of the heuristic's best score, none when one leads alone; defer: "
             "the heuristic's first choice of a state is taken unscored, the network orders the others "
             "when the search backtracks; wake: with defer, the network orders every state of a search "
-            "once it has backtracked)"
+            "once it has backtracked; calls: the network scores at most that many states of a search, "
+            "the rest keep the heuristic's order)"
         )
     lines += [
         "",
@@ -143,6 +144,9 @@ def main() -> None:
         default=None,
         help="store: score only those within this of the heuristic's best",
     )
+    parser.add_argument(
+        "--calls", type=int, default=None, help="store: the network scores at most N states of a search"
+    )
     switches = {
         "defer": "1 takes the heuristic's first choice unscored, the network orders the others",
         "wake": "1 (with defer) lets the network order every state once the search backtracked",
@@ -152,7 +156,13 @@ def main() -> None:
     args = parser.parse_args()
     checkpoint = torch.load(args.checkpoint, map_location="cpu", weights_only=True)
     flags = {name: None if getattr(args, name) is None else bool(getattr(args, name)) for name in switches}
-    knobs = (("top_m", args.top_m), ("blend", args.blend), ("margin", args.margin), *flags.items())
+    knobs = (
+        ("top_m", args.top_m),
+        ("blend", args.blend),
+        ("margin", args.margin),
+        ("calls", args.calls),
+        *flags.items(),
+    )
     search = {k: v for k, v in knobs if v is not None}
     if search:  # the guide's defaults (NetworkRanker reads them), kept with the weights they suit
         checkpoint["search"] = {**checkpoint.get("search", {}), **search}
