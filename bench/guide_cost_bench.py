@@ -32,8 +32,19 @@ import numpy as np
 import pandas as pd
 
 from eval.guides import GuideSpec
-from eval.heldout import PARTS, add_exclude, excluded, held_out, holdout_projects, part_of, trained_projects
-from zonegraph.data.dataset import project_of, stratified_sample
+from eval.heldout import (
+    HOLDOUT,
+    PARTS,
+    add_exclude,
+    excluded,
+    held_out,
+    holdout_projects,
+    labels_split,
+    of_projects,
+    part_of,
+    trained_projects,
+)
+from zonegraph.data.dataset import stratified_sample
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.zones.model import ZoneGraph
@@ -57,11 +68,9 @@ def chosen_designs(
     checkpoints trained on (and of one half of them by project, with ``part``); with their GT
     step counts."""
     designs = pd.read_parquet(gt / "designs.parquet")
-    if split == "holdout":
-        held = holdout_projects(models)
-        chosen = (designs["split"] == "train") & designs["design_id"].map(lambda d: project_of(d) in held)
-    else:
-        chosen = designs["split"] == split
+    chosen = designs["split"] == labels_split(split)
+    if split == HOLDOUT:
+        chosen &= designs["design_id"].isin(of_projects(designs["design_id"], holdout_projects(models)))
     designs = designs[
         chosen & (designs["steps"] >= min_gt) & designs["design_id"].map(lambda d: (graphs / d).is_dir())
     ]
@@ -175,7 +184,7 @@ def main() -> None:
     parser.add_argument("--part-seed", type=int, default=0, help="the seed that halves them")
     add_exclude(parser)
     parser.add_argument(
-        "--split", choices=["test", "holdout"], default="test", help="holdout: the models' held-out designs"
+        "--split", choices=["test", HOLDOUT], default="test", help="holdout: the models' held-out designs"
     )
     parser.add_argument("--min-gt", type=int, default=0, help="only designs of at least this many GT steps")
     parser.add_argument("--out", type=Path, default=Path("bench_out/guide_cost"))

@@ -33,7 +33,7 @@ def trained_projects(models: Sequence[str | Path]) -> tuple[set[str], list[str]]
     seen: set[str] = set()
     silent = []
     for model in models:
-        projects = _projects(Path(model))
+        projects = _listed(Path(model), "train_projects")
         if projects is None:
             silent.append(str(model))
         else:
@@ -41,15 +41,17 @@ def trained_projects(models: Sequence[str | Path]) -> tuple[set[str], list[str]]
     return seen, silent
 
 
-def _projects(model: Path) -> list[str] | None:
+def _listed(model: Path, key: str) -> list[str] | None:
+    """The projects a checkpoint or its numpy fold lists under ``key`` (``train_projects``,
+    ``holdout_projects``), or None where it lists none."""
     if model.suffix == ".npz":
         from zonegraph.network.folded import FoldedScorer
 
-        return list(FoldedScorer.load(model).train_projects) or None
+        return list(getattr(FoldedScorer.load(model), key)) or None
     import torch  # only when a PyTorch model is evaluated
 
     provenance = torch.load(model, map_location="cpu", weights_only=True).get("provenance", {})
-    return provenance.get("train_projects")
+    return provenance.get(key)
 
 
 def holdout_projects(models: Sequence[str | Path]) -> set[str]:
@@ -57,7 +59,7 @@ def holdout_projects(models: Sequence[str | Path]) -> set[str]:
     checkpoint's ``provenance.holdout_projects``); SystemExit naming a model that holds none out."""
     held: set[str] | None = None
     for model in models:
-        projects = _holdout(Path(model))
+        projects = _listed(Path(model), "holdout_projects")
         if not projects:
             raise SystemExit(f"{model}: error: trained with no held-out projects (train.holdout_fraction 0)")
         held = set(projects) if held is None else held & set(projects)
@@ -66,15 +68,14 @@ def holdout_projects(models: Sequence[str | Path]) -> set[str]:
     return held
 
 
-def _holdout(model: Path) -> list[str]:
-    if model.suffix == ".npz":
-        from zonegraph.network.folded import FoldedScorer
+def labels_split(split: str) -> str:
+    """The pipeline split a named split reads: the held-out designs are of the training split."""
+    return "train" if split == HOLDOUT else split
 
-        return list(FoldedScorer.load(model).holdout_projects)
-    import torch
 
-    provenance = torch.load(model, map_location="cpu", weights_only=True).get("provenance", {})
-    return list(provenance.get("holdout_projects", []))
+def of_projects(design_ids: Iterable[str], projects: set[str]) -> list[str]:
+    """The designs whose project is in ``projects``, in their order (`held_out`'s complement)."""
+    return [d for d in design_ids if project_of(d) in projects]
 
 
 def held_out(design_ids: Iterable[str], projects: set[str]) -> list[str]:

@@ -27,15 +27,17 @@ import pyarrow.dataset as ds
 
 from eval.guides import GuideSpec
 from eval.heldout import (
+    HOLDOUT,
     PARTS,
     add_exclude,
     excluded,
     held_out_labelled,
     holdout_projects,
+    labels_split,
+    of_projects,
     part_of,
     trained_projects,
 )
-from zonegraph.data.dataset import project_of
 from zonegraph.sequence.proposals import Op, Proposal
 from zonegraph.sequence.rankers import GTPlace, Ranker, gt_place, make_ranker, score_step
 from zonegraph.zones.model import ZoneGraph
@@ -430,11 +432,10 @@ def main(argv: list[str] | None = None) -> None:
     else:
         models = [GuideSpec.parse(f"net={m}").model or "" for m in args.model]
         seen, _ = trained_projects(models)
-        split = "train" if args.split == "holdout" else args.split
+        split = labels_split(args.split)
         kept = excluded(held_out_labelled(args.labels, split, seen), args.exclude)
-        if args.split == "holdout":
-            held = holdout_projects(models)
-            kept = [d for d in kept if project_of(d) in held]
+        if args.split == HOLDOUT:
+            kept = of_projects(kept, holdout_projects(models))
         designs = part_of(kept, args.part, args.part_seed)[: args.limit]
         print(f"rank: {len(designs)} {args.split} designs of no project a model trained on", flush=True)
         guides = make_guides(args.guides, args.model, args.seed)

@@ -41,6 +41,8 @@ from eval.heldout import (
     held_out,
     held_out_labelled,
     holdout_projects,
+    labels_split,
+    of_projects,
     trained_projects,
 )
 from eval.programs import program_measures
@@ -57,7 +59,6 @@ from eval.rank import (
 from eval.searches import Search, Target, folder_targets, run_searches, split_targets
 from eval.strips import pick_designs, write_strips
 from zonegraph.configs import Config, ConfigError, InferConfig, load_section
-from zonegraph.data.dataset import project_of
 
 SHIPPED = Path(zonegraph.network.__file__).resolve().parent / "checkpoints" / "scorer.pt"  # no torch import
 MARKS = (1.0, 5.0, 20.0)  # seconds at which IoU and exact rate are reported as metrics
@@ -150,15 +151,15 @@ def searches_for(
 
 
 def split_of(args: argparse.Namespace) -> str:
-    """The pipeline split ``--designs`` names: the held-out designs are of the training split."""
-    return "train" if args.designs == HOLDOUT else str(args.designs)
+    """The pipeline split ``--designs`` names (`labels_split`)."""
+    return labels_split(str(args.designs))
 
 
 def evaluated(args: argparse.Namespace, design_ids: list[str]) -> list[str]:
     """``design_ids`` of no project a model trained on, less ``--exclude``, and with ``--designs
     holdout`` only those of the projects the models held out."""
     kept = excluded(held_out(design_ids, args.trained), args.exclude)
-    return kept if args.held is None else [d for d in kept if project_of(d) in args.held]
+    return kept if args.held is None else of_projects(kept, args.held)
 
 
 def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tuple[pd.DataFrame, str]:

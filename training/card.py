@@ -174,4 +174,3 @@ def main() -> None:
 
 if __name__ == "__main__":
     main()
-

@@ -432,10 +432,10 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     model = ProposalScorer(config.model).to(device)
     teacher, taught = load_teacher(config, device)
     holdout = sorted({project_of(d) for d in split.holdout})
-    if set(taught) & set(holdout):
+    if overlap := set(taught) & set(holdout):
         raise SystemExit(
-            f"train: {config.teacher}: the teacher trained on {len(set(taught) & set(holdout))} of the "
-            "held-out projects: train it with the same holdout_fraction and holdout_seed"
+            f"train: {config.teacher}: the teacher trained on {len(overlap)} of the held-out projects: "
+            "train it with the same holdout_fraction and holdout_seed"
         )
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
     out = Path(config.out_dir)
