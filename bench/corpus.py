@@ -10,7 +10,7 @@ from typing import Any
 
 from zonegraph.testing import CORPUS
 
-__all__ = ["CORPUS", "replayed", "require_corpus", "run_designs", "write_results"]
+__all__ = ["CORPUS", "closest_graphs", "replayed", "require_corpus", "run_designs", "write_results"]
 
 
 def require_corpus(path: Path) -> None:
@@ -55,3 +55,11 @@ def write_results(rows: list[dict], table: str, out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     (out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
     (out / "results.md").write_text(table + "\n")
+
+
+def closest_graphs(folder: Path, targets: list[int]) -> dict[int, Path]:
+    """The saved graph whose zone count is closest to each target (read from the zone tables)."""
+    import pyarrow.parquet as pq
+
+    counts = {g: pq.read_metadata(g / "zones.parquet").num_rows for g in sorted(folder.iterdir())}
+    return {t: min(counts, key=lambda g: abs(counts[g] - t)) for t in targets}

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from bench.corpus import closest_graphs
 from zonegraph.network.encoding import geometry_of
 from zonegraph.network.model import ModelConfig, ProposalScorer
 from zonegraph.network.scoring import score_state
@@ -26,14 +27,6 @@ from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
 from zonegraph.sequence.rankers import HeuristicRanker
 from zonegraph.zones.model import ZoneGraph
 from zonegraph.zones.storage import load_zone_graph
-
-
-def closest_graphs(folder: Path, targets: list[int]) -> dict[int, Path]:
-    """The saved graph whose zone count is closest to each target (read from the zone tables)."""
-    import pyarrow.parquet as pq
-
-    counts = {g: pq.read_metadata(g / "zones.parquet").num_rows for g in sorted(folder.iterdir())}
-    return {t: min(counts, key=lambda g: abs(counts[g] - t)) for t in targets}
 
 
 def proposals_of(graph: ZoneGraph, count: int, seed: int = 0) -> tuple[np.ndarray, list[Proposal]]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 
 import numpy as np
@@ -11,7 +12,7 @@ import torch
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.network.checkpoint import SHIPPED, fold, fold_checkpoint, read_checkpoint
-from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer
+from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State
 from zonegraph.network.model import ModelConfig, ProposalScorer
 from zonegraph.network.ranker import NetworkRanker, NumpyScorer, open_scorer
 from zonegraph.network.scoring import TorchScorer
@@ -61,6 +62,15 @@ def _both(checkpoint: dict, graph, canvas, proposals) -> tuple[np.ndarray, np.nd
     return folded, reference
 
 
+def _forced_within_reach(self, state, zones, fresh=False):
+    """`FoldedScorer._reach` without its cost test: the within-reach path whatever it costs."""
+    return self._spread(state, zones)
+
+
+def _never(self, state, zones, fresh=False):
+    return None
+
+
 @requires_samples
 @pytest.mark.parametrize(
     "config",
@@ -71,7 +81,9 @@ def _both(checkpoint: dict, graph, canvas, proposals) -> tuple[np.ndarray, np.nd
     ],
     ids=["flags+features", "points+features", "points"],
 )
-def test_a_folded_scorer_scores_real_states_as_pytorch(states, config):
+@pytest.mark.parametrize("path", ["within reach", "every zone"])
+def test_a_folded_scorer_scores_real_states_as_pytorch(states, config, path, monkeypatch):
+    monkeypatch.setattr(FoldedScorer, "_reach", _forced_within_reach if path == "within reach" else _never)
     model = _trained_like(config)
     checkpoint = {
         "model": config.__dict__,
@@ -146,12 +158,24 @@ def test_computing_only_the_zones_within_reach_scores_as_computing_every_zone(st
         ops = np.array([1 if p.op is Op.UNION else -1 for p in proposals])
         features = proposal_features(graph, canvas, proposals, 0)
         chosen = scorer.score(graph, canvas, zones, ops, features)
-        paths.append(len(folded._computed(scorer._state, zones)[0]) - len(proposals))
+        paths.append(folded._reach(scorer._state, zones) is not None)
         with monkeypatch.context() as patch:
-            patch.setattr(FoldedScorer, "_computed", lambda self, state, z: [np.ones(z.shape, bool)] * 4)
+            patch.setattr(FoldedScorer, "_reach", _never)
             every = scorer.score(graph, canvas, zones, ops, features)
         np.testing.assert_allclose(chosen, every, atol=1e-6)
-    assert 1 in paths, "no state took the within-reach path: the comparison tests nothing"
+    assert any(paths), "no state took the within-reach path: the comparison tests nothing"
+
+
+@requires_samples
+@pytest.mark.parametrize("dense_zones", [0, 10_000], ids=["sparse", "dense"])
+def test_the_sparse_and_the_dense_neighbour_mean_score_as_pytorch(states, monkeypatch, dense_zones):
+    monkeypatch.setattr("zonegraph.network.folded.DENSE_ZONES", dense_zones)
+    config = ModelConfig(use_points=False, features=FEATURES)
+    model = _trained_like(config)
+    checkpoint = {"model": config.__dict__, "state_dict": model.state_dict(), "train": {}}
+    for graph, canvas, proposals in states:
+        folded, reference = _both(checkpoint, graph, canvas, proposals)
+        assert np.abs(folded - reference).max() < 2e-5
 
 
 @requires_samples
@@ -329,3 +353,21 @@ def test_a_guide_with_a_call_budget_takes_the_heuristics_order_once_it_is_spent(
     deferring = NetworkRanker(defer=True, calls=0)  # the heuristic's order throughout: no call at all
     assert list(deferring.order_at(graph, canvas, proposals, 0, 5)) == heuristic[:5]
     assert not deferring.scorer.loaded
+
+
+@requires_samples
+def test_a_state_s_codes_updated_from_the_last_state_are_its_codes_computed_afresh(states):
+    folded = fold(_trained_like(ModelConfig(use_points=False, features=FEATURES)))
+    updated = 0
+    for graph, canvas, proposals in states:
+        state = State.of(graph.zone_inside, canvas, graph.edges.astype(np.int64))
+        walk = [canvas] + [p.apply(canvas) for p in proposals[:6]] + [canvas]
+        codes = folded.state_codes(state, None)
+        for before, after in itertools.pairwise(walk):
+            previous = folded.state_codes(state.with_canvas(before), None)
+            updated += folded._update_reach(state.with_canvas(after), previous) is not None
+            codes = folded.state_codes(state.with_canvas(after), None, codes)
+            fresh = folded.state_codes(state.with_canvas(after), None)
+            for mine, theirs in zip(codes.layers, fresh.layers, strict=True):
+                np.testing.assert_allclose(mine, theirs, atol=1e-6)
+    assert updated, "every step computed every zone: the update was never tested"

@@ -19,6 +19,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -28,9 +29,15 @@ import scipy.sparse as sp
 from zonegraph.zones.model import ZoneGraph
 
 SLOPE = 0.2  # the LeakyReLU of every layer (zonegraph.network.model)
-# Up to this many zones the neighbour mean is a dense product: scipy's sparse one costs tens of
-# microseconds per call before any arithmetic, more than a small graph's whole product.
-DENSE_ZONES = 256
+# Up to this many zones the neighbour mean is a dense product, above it scipy's sparse one: a zone
+# has four or five neighbours whatever the graph's size, so the dense product does Z / 5 times the
+# arithmetic, and scipy's few microseconds of overhead per call are won back from about 32 zones
+# on (measured on corpus graphs, one thread: 47 zones 29 vs 15 us, 128 zones 146 vs 30 us).
+DENSE_ZONES = 32
+# The fixed cost of scoring a state within the proposals' reach (a dozen sparse products and their
+# index arrays, about 0.75 ms) in zone rows of scoring every zone of every proposal (0.3 us each):
+# measured on corpus graphs of 57 to 422 zones, where every zone costs less up to about 100.
+REACH_ROWS = 2500
 # The shipped checkpoint folded (python -m training.fold); a test keeps it equal to scorer.pt's.
 SHIPPED_FOLDED = Path(__file__).resolve().parent / "checkpoints" / "scorer.npz"
 
@@ -116,61 +123,165 @@ class FoldedScorer:
         ops: np.ndarray,
         geometry: np.ndarray | None = None,
         features: np.ndarray | None = None,
+        memo: CodeMemo | None = None,
     ) -> np.ndarray:
         """P(positive) of each of P proposals of one state.
 
         A proposal changes the flags of its extrusion's zones only, and a round of message passing
         carries a change one zone further, so after round r a proposal's zone codes differ from
         the state's own (no extrusion) only within r steps of its extrusion. Where that saves
-        work, the state's codes are computed once (row 0) and each proposal's only where they can
-        differ: on a large graph most zones of most proposals are never computed. On a small
-        graph, where every zone is soon within reach, every zone of every proposal is computed
-        and the state's row is left out. Exact either way: an untouched zone's code *is* the
-        state's.
+        work, the state's codes are computed once and each proposal's only where they can differ
+        (`_pool_within_reach`): on a large graph most zones of most proposals are never computed.
+        On a small graph, where every zone is soon within reach, every zone of every proposal is
+        computed (`_pool_every_zone`). Exact either way: an untouched zone's code *is* the state's.
+        The state's own codes change between two states of a search only within reach of the zones
+        whose canvas flag differs, so with a ``memo`` of the graph's last state they are updated
+        there (`state_codes`) rather than computed again.
 
         Shapes:
             zones: (P, Z) bool, the extrusions; ops: (P,) +1 union, -1 subtract; geometry: (Z, H)
             from `encode_geometry`; features: (P, F) every column of FEATURES; returns (P,).
         """
-        p, z = zones.shape
-        masks = self._computed(state, zones.astype(bool))
-        k = len(masks[0])  # P + 1 with the state's row first, or P
-        own = slice(k - p, None)  # the proposals' rows
-        first = self.zone_in[0]
-        flags = np.zeros((k, z, 4), np.float32)
-        flags[:, :, 0] = state.inside
-        flags[:, :, 1] = state.canvas
-        flags[own, :, 2] = zones
-        flags[own, :, 3] = zones * ops[:, None]
-        rows = np.nonzero(masks[0])
-        x = flags[rows] @ first.weight[-4:] + first.bias
-        if geometry is not None:
-            x += geometry[rows[1]]
-        x = _spread(run(self.zone_in[1:], _activate(x, first)), rows, k, z, with_state=k > p)
-        for chain, mask in zip(self.rounds, masks[1:], strict=True):
-            rows = np.nonzero(mask)
-            mean = state.neighbours @ x.transpose(1, 0, 2).reshape(z, -1)
-            mean = mean.reshape(z, k, -1).transpose(1, 0, 2)
-            codes = run(chain, np.concatenate([x[rows], mean[rows]], axis=1))
-            x = _spread(codes, rows, k, z, with_state=k > p)
-        pooled = x[own].max(axis=1)
+        zones = zones.astype(bool)
+        extrusion = np.where(zones, np.where(ops > 0, 1, 2)[:, None], 0)  # (P, Z): 0 none, 1 union, 2 cut
+        reach = self._reach(state, zones, fresh=memo is None or memo.last is None)
+        if reach is None:
+            pooled = self._pool_every_zone(state, extrusion, geometry)
+        else:
+            codes = self.state_codes(state, geometry, memo.last if memo else None)
+            if memo is not None:
+                memo.last = codes
+            pooled = self._pool_within_reach(state, extrusion, geometry, reach, codes)
         if self.columns:
+            p = len(zones)
             taken = np.zeros((p, max(self.columns) + 1), np.float32) if features is None else features
             pooled = np.concatenate([pooled, run(self.features, taken[:, list(self.columns)])], axis=1)
         logits = run(self.readout, pooled)
         return 1.0 / (1.0 + np.exp(logits[:, 0] - logits[:, 1]))
 
-    def _computed(self, state: State, zones: np.ndarray) -> list[np.ndarray]:
-        """Which zone codes each layer computes, (K, Z) per layer: K = P + 1 with the state's
-        row first (every zone) and each proposal's zones within reach of its extrusion, or K = P
-        with every zone, whichever computes fewer rows."""
-        reach = [zones]
+    def _reach(self, state: State, zones: np.ndarray, fresh: bool = False) -> list[np.ndarray] | None:
+        """(P, Z) per layer: the zones whose codes each proposal changes after ``zone_in`` and
+        each round; None where computing them (and, ``fresh``, the state's codes) costs as much
+        as every zone of every proposal."""
+        reach = self._spread(state, zones)
+        p, z = zones.shape
+        rows = sum(int(m.sum()) for m in reach) + REACH_ROWS + (z * len(reach) if fresh else 0)
+        return None if rows >= p * z * len(reach) else reach
+
+    def _spread(self, state: State, changed: np.ndarray) -> list[np.ndarray]:
+        """(K, Z) per layer: the zones whose codes a change of flags at ``changed`` (K, Z) reaches
+        after ``zone_in`` and each round (a round carries it one neighbour further)."""
+        reach = [changed]
         for _ in self.rounds:
             reach.append(reach[-1] | state.reach(reach[-1]))
-        p, z = zones.shape
-        if sum(int(m.sum()) for m in reach) + z * len(reach) >= p * z * len(reach):
-            return [np.ones((p, z), bool)] * len(reach)
-        return [np.concatenate([np.ones((1, z), bool), m]) for m in reach]
+        return reach
+
+    def _entry(
+        self, inside: np.ndarray, canvas: np.ndarray, extrusion: np.ndarray, geometry: np.ndarray | None
+    ) -> np.ndarray:
+        """(N, H) ``zone_in`` of N zones from their flags (extrusion 0 none, 1 union, 2 subtract)
+        and their rows of ``geometry``: without geometry a zone's input takes one of twelve values,
+        so its code is a row of `flag_codes`."""
+        if geometry is None:
+            return self.flag_codes[6 * inside + 3 * canvas + extrusion]
+        first = self.zone_in[0]
+        flags = np.stack([inside, canvas, extrusion > 0, (extrusion == 1) - 1.0 * (extrusion == 2)], axis=1)
+        x = flags.astype(np.float32) @ first.weight[-4:] + first.bias + geometry
+        return run(self.zone_in[1:], _activate(x, first))
+
+    @cached_property
+    def flag_codes(self) -> np.ndarray:
+        """(12, H) ``zone_in`` of each flag value a zone without geometry can have, row ``6 *
+        inside + 3 * canvas + extrusion``."""
+        flags = np.zeros((12, 4), np.float32)
+        for row in range(12):
+            inside, rest = divmod(row, 6)
+            canvas, extrusion = divmod(rest, 3)
+            flags[row] = (inside, canvas, extrusion > 0, (0, 1, -1)[extrusion])
+        return run(self.zone_in, flags)
+
+    def _pool_every_zone(
+        self, state: State, extrusion: np.ndarray, geometry: np.ndarray | None
+    ) -> np.ndarray:
+        """(P, H) each proposal's zone codes pooled, every zone of every proposal computed."""
+        p, z = extrusion.shape
+        x = self._entry(
+            np.tile(state.inside, p),
+            np.tile(state.canvas, p),
+            extrusion.ravel(),
+            None if geometry is None else np.tile(geometry, (p, 1)),
+        ).reshape(p, z, -1)
+        for chain in self.rounds:
+            mean = state.neighbours @ x.transpose(1, 0, 2).reshape(z, -1)
+            mean = mean.reshape(z, p, -1).transpose(1, 0, 2)
+            x = _round(chain, x.reshape(p * z, -1), mean.reshape(p * z, -1)).reshape(p, z, -1)
+        return x.max(axis=1)
+
+    def state_codes(
+        self, state: State, geometry: np.ndarray | None, previous: StateCodes | None = None
+    ) -> StateCodes:
+        """Every zone's code at the state's canvas with no extrusion, after ``zone_in`` and each
+        round; from ``previous`` (the same graph at another canvas) only the zones within reach of
+        a changed flag are computed, unless they are half the graph or more."""
+        z = len(state.canvas)
+        if previous is not None and np.array_equal(state.canvas, previous.canvas):
+            return previous
+        reach = None if previous is None else self._update_reach(state, previous)
+        if previous is None or reach is None:
+            layers = [self._entry(state.inside, state.canvas, np.zeros(z, np.int64), geometry)]
+            for chain in self.rounds:
+                layers.append(_round(chain, layers[-1], state.neighbours @ layers[-1]))
+            return StateCodes(state.canvas, tuple(layers))
+        rows = np.flatnonzero(reach[0])
+        first = previous.layers[0].copy()
+        unchanged = np.zeros(len(rows), np.int64)  # no extrusion
+        first[rows] = self._entry(
+            state.inside[rows], state.canvas[rows], unchanged, None if geometry is None else geometry[rows]
+        )
+        layers = [first]
+        for chain, mask, before in zip(self.rounds, reach[1:], previous.layers[1:], strict=True):
+            rows = np.flatnonzero(mask)
+            mean = _mean_at(state.links, rows, layers[-1])
+            layer = before.copy()
+            layer[rows] = _round(chain, layers[-1][rows], mean)
+            layers.append(layer)
+        return StateCodes(state.canvas, tuple(layers))
+
+    def _update_reach(self, state: State, previous: StateCodes) -> list[np.ndarray] | None:
+        """(Z,) per layer: the zones whose codes differ from ``previous``'s, or None where they
+        are half the graph or more (computing every zone costs less there)."""
+        reach = [m[0] for m in self._spread(state, (state.canvas != previous.canvas)[None])]
+        return None if 2 * sum(int(m.sum()) for m in reach) >= len(state.canvas) * len(reach) else reach
+
+    def _pool_within_reach(
+        self,
+        state: State,
+        extrusion: np.ndarray,
+        geometry: np.ndarray | None,
+        reach: list[np.ndarray],
+        codes: StateCodes,
+    ) -> np.ndarray:
+        """(P, H) each proposal's zone codes pooled: the state's ``codes`` where a proposal left a
+        zone's code as it is, computed within its reach.
+
+        A layer's codes are the state's (rows ``0 .. Z-1``) and then the proposals' reached zones
+        in the order of `np.nonzero`; ``where`` (P, Z) holds the row of each proposal's code of each
+        zone, so one sparse product gives every reached zone's neighbour mean."""
+        p, z = extrusion.shape
+        pk, pz = np.nonzero(reach[0])
+        own = self._entry(
+            state.inside[pz], state.canvas[pz], extrusion[pk, pz], None if geometry is None else geometry[pz]
+        )
+        where = np.tile(np.arange(z, dtype=np.int32), (p, 1))
+        for chain, mask, before in zip(self.rounds, reach[1:], codes.layers[:-1], strict=True):
+            where[pk, pz] = z + np.arange(len(pk))  # a round reaches every zone the one before did
+            pk, pz = np.nonzero(mask)
+            x = np.concatenate([before, own])
+            own = _round(chain, x[where[pk, pz]], _mean_at(state.links, pz, x, where, pk))
+        pooled = np.full((p, own.shape[1]), -np.inf, np.float32)
+        firsts = np.flatnonzero(np.diff(pk, prepend=-1))  # each proposal's first reached zone
+        pooled[pk[firsts]] = np.maximum.reduceat(own, firsts, axis=0)
+        return np.maximum(pooled, _max_elsewhere(codes.layers[-1], reach[-1]))
 
     def save(self, path: str | Path) -> None:
         """Writes the configuration and every layer's arrays as one ``.npz`` (no pickled objects):
@@ -292,16 +403,47 @@ def zone_samples(graph: ZoneGraph, points_per_zone: int | None = None, seed: int
     return np.ascontiguousarray(pts.transpose(0, 2, 1), dtype=np.float32)
 
 
-def _spread(codes: np.ndarray, rows: tuple[np.ndarray, ...], k: int, z: int, with_state: bool) -> np.ndarray:
-    """(K, Z, H) zone codes from those computed at ``rows``: with the state's row (0, whole and
-    first), every zone of a proposal not computed keeps the state's code; without, every zone
-    was computed."""
-    if not with_state:
-        return codes.reshape(k, z, -1)
-    x = np.empty((k, z, codes.shape[1]), np.float32)
-    x[:] = codes[:z]
-    x[rows] = codes
-    return x
+def _round(chain: Chain, x: np.ndarray, mean: np.ndarray) -> np.ndarray:
+    """One round of message passing over N zones: (N, H) their codes and their neighbours' means
+    in, (N, H) out (the first layer reads both side by side: two products instead of a copy)."""
+    first, h = chain[0], x.shape[1]
+    y = x @ first.weight[:h]
+    y += mean @ first.weight[h:]
+    y += first.bias
+    return run(chain[1:], _activate(y, first))
+
+
+def _mean_at(
+    links: sp.csr_matrix,
+    zones: np.ndarray,
+    x: np.ndarray,
+    where: np.ndarray | None = None,
+    owners: np.ndarray | None = None,
+) -> np.ndarray:
+    """(N, H) the neighbour mean of N ``zones``, each neighbour's code read from its row of
+    ``x``: the zone's own row, or with ``where`` (P, Z) row ``where[owners[i], zone]``. The
+    product's index arrays are 32-bit, as scipy's own: it checks 64-bit ones at twice the cost."""
+    counts = np.diff(links.indptr)[zones]
+    indptr = np.zeros(len(zones) + 1, np.int32)
+    np.cumsum(counts, out=indptr[1:])
+    at = np.repeat(links.indptr[zones] - indptr[:-1], counts) + np.arange(indptr[-1], dtype=np.int32)
+    columns = links.indices[at]
+    if where is not None and owners is not None:
+        columns = where[np.repeat(owners, counts), columns]
+    matrix = sp.csr_matrix((links.data[at], columns.astype(np.int32), indptr), shape=(len(zones), len(x)))
+    return matrix @ x
+
+
+def _max_elsewhere(codes: np.ndarray, reached: np.ndarray) -> np.ndarray:
+    """(P, H) per proposal the greatest code of each channel over the zones it did not reach,
+    from the state's (Z, H) ``codes`` (-inf where it reached every zone): the channel's greatest
+    zone, unless the proposal reached it."""
+    top = codes.argmax(axis=0)  # (H,)
+    best = np.broadcast_to(codes[top, np.arange(codes.shape[1])], (len(reached), codes.shape[1])).copy()
+    taken = np.flatnonzero(reached[:, top].any(axis=1))
+    if len(taken):
+        best[taken] = np.where(reached[taken, :, None], -np.inf, codes[None]).max(axis=1)
+    return best
 
 
 def _activate(x: np.ndarray, layer: Affine) -> np.ndarray:
@@ -309,6 +451,21 @@ def _activate(x: np.ndarray, layer: Affine) -> np.ndarray:
     if layer.activation:
         np.maximum(x, SLOPE * x, out=x)
     return x
+
+
+@dataclass(frozen=True)
+class StateCodes:
+    """Every zone's code at one canvas with no extrusion: after ``zone_in``, then each round."""
+
+    canvas: np.ndarray  # (Z,) bool
+    layers: tuple[np.ndarray, ...]  # (Z, H) each
+
+
+@dataclass
+class CodeMemo:
+    """The last state's codes of one graph, kept by its scorer between the states of a search."""
+
+    last: StateCodes | None = None
 
 
 @dataclass(frozen=True)
@@ -323,6 +480,7 @@ class State:
     inside: np.ndarray
     canvas: np.ndarray
     neighbours: sp.csr_matrix | np.ndarray
+    links: sp.csr_matrix  # the same mean, sparse whatever the size (`FoldedScorer._pool_within_reach`)
 
     @classmethod
     def of(cls, inside: np.ndarray, canvas: np.ndarray, edges: np.ndarray) -> State:
@@ -334,13 +492,12 @@ class State:
         degree = np.asarray(adjacency.sum(axis=1)).ravel()
         scale = np.divide(1.0, degree, out=np.zeros_like(degree), where=degree > 0).astype(np.float32)
         neighbours = sp.csr_matrix(sp.diags(scale) @ adjacency, dtype=np.float32)
-        if n <= DENSE_ZONES:
-            return cls(inside.astype(bool), canvas.astype(bool), neighbours.toarray())
-        return cls(inside.astype(bool), canvas.astype(bool), neighbours)
+        dense = neighbours.toarray() if n <= DENSE_ZONES else neighbours
+        return cls(inside.astype(bool), canvas.astype(bool), dense, neighbours)
 
     def with_canvas(self, canvas: np.ndarray) -> State:
         """The same graph at another canvas."""
-        return State(self.inside, canvas.astype(bool), self.neighbours)
+        return State(self.inside, canvas.astype(bool), self.neighbours, self.links)
 
     def reach(self, changed: np.ndarray) -> np.ndarray:
         """(K, Z) bool: zones with a neighbour among each row's ``changed`` zones (K, Z)."""

@@ -48,7 +48,7 @@ from typing import Any, Protocol
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
-from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State, zone_samples
+from zonegraph.network.folded import SHIPPED_FOLDED, CodeMemo, FoldedScorer, State, zone_samples
 from zonegraph.plugins import model_problem
 from zonegraph.sequence.features import proposal_features, target_surfaces
 from zonegraph.sequence.proposals import Op, Proposal
@@ -78,7 +78,8 @@ class StateScorer(Protocol):
 
 
 class NumpyScorer:
-    """A `FoldedScorer` with its graph's adjacency and geometry codes kept between states.
+    """A `FoldedScorer` with its graph's adjacency, geometry codes and last state's zone codes kept
+    between states.
 
     OpenBLAS would spread each small product over every core, and with the other core busy (two
     pipeline workers on two cores) its threads wait on each other: a 40-zone state took 94 ms
@@ -93,6 +94,7 @@ class NumpyScorer:
         self._graph: ZoneGraph | None = None
         self._state: State | None = None
         self._geometry: np.ndarray | None = None
+        self._memo = CodeMemo()
 
     def score(
         self,
@@ -104,12 +106,13 @@ class NumpyScorer:
     ) -> np.ndarray:
         with _blas_threads().limit(limits=1, user_api="blas"):
             if graph is not self._graph or self._state is None:
-                self._graph = graph
+                self._graph, self._memo = graph, CodeMemo()
                 self._state = State.of(graph.zone_inside, canvas, graph.edges.astype(np.int64))
                 points = zone_samples(graph, self.points_per_zone) if self.folded.points else None
                 self._geometry = None if points is None else self.folded.encode_geometry(points)
             state = self._state.with_canvas(canvas)
-            return self.folded.score(state, zones, ops.astype(np.float32), self._geometry, features)
+            ops32 = ops.astype(np.float32)
+            return self.folded.score(state, zones, ops32, self._geometry, features, self._memo)
 
 
 class LazyScorer:

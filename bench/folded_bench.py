@@ -1,0 +1,142 @@
+"""Milliseconds the network guide spends on a state it scores, by graph size, beside the heuristic's.
+
+    python -m bench.folded_bench [--graphs data/zonegraphs/graphs] [--zones 60 130 250 500 1300 4000]
+                                 [--states 40] [--top-m 8] [--model PATH] [--repeats 3]
+
+For each zone count, the saved zone graph (from a pipeline run) closest to it is searched with the
+heuristic for ``--states`` expansions; the states it expands are then scored, in the search's
+order, by the folded scorer the guide runs (the shipped one by default) on the heuristic's best
+``--top-m`` proposals of each (as the shipped guide scores them) with their features, by one
+scorer that keeps what it encodes per graph between states, as in search. The least time of
+``--repeats`` passes, one BLAS thread; ``heuristic ms`` is the heuristic's scoring of every
+proposal of the same states, ``features ms`` the proposal features the network reads.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from bench.corpus import closest_graphs
+from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer
+from zonegraph.network.ranker import NumpyScorer
+from zonegraph.sequence.best_first import SearchConfig, search
+from zonegraph.sequence.features import proposal_features, target_surfaces
+from zonegraph.sequence.proposals import Op, Proposal, ProposalGenerator
+from zonegraph.sequence.rankers import HeuristicRanker
+from zonegraph.zones.model import ZoneGraph
+from zonegraph.zones.storage import load_zone_graph
+
+
+@dataclass(frozen=True)
+class Visit:
+    """One expanded state: its canvas, every proposal, and the network's share of them."""
+
+    canvas: np.ndarray
+    proposals: list[Proposal]
+    picked: list[Proposal]  # the heuristic's best M
+    zones: np.ndarray  # (M, Z) bool
+    ops: np.ndarray  # (M,) +1 / -1
+    features: np.ndarray  # (M, F)
+
+
+class Recorder(HeuristicRanker):
+    """The heuristic, keeping every state it is asked to score (each expansion asks once)."""
+
+    def __init__(self) -> None:
+        self.seen: list[tuple[np.ndarray, list[Proposal]]] = []
+
+    def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
+        self.seen.append((canvas.copy(), proposals))
+        return super().score(graph, canvas, proposals)
+
+
+def visits(graph: ZoneGraph, states: int, top_m: int) -> list[Visit]:
+    """The first ``states`` states a heuristic search of ``graph`` expands with more than one
+    proposal (a state with one is never scored)."""
+    recorder = Recorder()
+    search(graph, recorder, SearchConfig(budget_s=60.0, max_depth=20), ProposalGenerator(graph))
+    on_target, out = target_surfaces(graph), []
+    for canvas, proposals in recorder.seen:
+        if len(proposals) < 2:
+            continue
+        scores = HeuristicRanker().score(graph, canvas, proposals)
+        picked = [proposals[i] for i in np.sort(np.argsort(-scores, kind="stable")[:top_m])]
+        zones = np.stack([p.zones for p in picked]).astype(bool)
+        ops = np.array([1 if p.op is Op.UNION else -1 for p in picked], np.float32)
+        features = proposal_features(graph, canvas, picked, 1, on_target)
+        out.append(Visit(canvas, proposals, picked, zones, ops, features))
+        if len(out) == states:
+            break
+    return out
+
+
+def least_ms(run: Callable[[], None], count: int, repeats: int) -> float:
+    """Milliseconds per item of the fastest of ``repeats`` passes over ``count`` items."""
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.perf_counter()
+        run()
+        best = min(best, time.perf_counter() - start)
+    return 1000 * best / max(count, 1)
+
+
+def time_graph(graph: ZoneGraph, model: Path, states: int, top_m: int, repeats: int) -> dict[str, float]:
+    """Milliseconds per state of the network, its features and the heuristic on ``graph``."""
+    seen = visits(graph, states, top_m)
+    folded = FoldedScorer.load(model, projects=False)
+    on_target = target_surfaces(graph)
+
+    def network() -> None:
+        scorer = NumpyScorer(folded)  # a new search: nothing kept from the last pass
+        for v in seen:
+            scorer.score(graph, v.canvas, v.zones, v.ops, v.features)
+
+    def features() -> None:
+        for v in seen:
+            proposal_features(graph, v.canvas, v.picked, 1, on_target)
+
+    def heuristic() -> None:
+        for v in seen:
+            HeuristicRanker().score(graph, v.canvas, v.proposals)
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return {
+            "states": len(seen),
+            "network": least_ms(network, len(seen), repeats),
+            "features": least_ms(features, len(seen), repeats),
+            "heuristic": least_ms(heuristic, len(seen), repeats),
+        }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--graphs", type=Path, default=Path("data/zonegraphs/graphs"))
+    parser.add_argument("--zones", type=int, nargs="+", default=[60, 130, 250, 500, 1300, 4000])
+    parser.add_argument("--states", type=int, default=40)
+    parser.add_argument("--top-m", type=int, default=8)
+    parser.add_argument("--model", type=Path, default=SHIPPED_FOLDED)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    if not args.graphs.is_dir():
+        raise SystemExit(f"{args.graphs}: no saved zone graphs (run the zonegraphs stage first)")
+    header = "| zones | states | network ms | features ms | heuristic ms | network / heuristic |"
+    print(header + "\n" + "|---" * 6 + "|")
+    for folder in closest_graphs(args.graphs, args.zones).values():
+        graph = load_zone_graph(folder, solids=False)
+        t = time_graph(graph, args.model, args.states, args.top_m, args.repeats)
+        print(
+            f"| {graph.n_zones} | {t['states']:.0f} | {t['network']:.2f} | {t['features']:.2f} | "
+            f"{t['heuristic']:.2f} | {t['network'] / t['heuristic']:.1f}x |",
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    main()
