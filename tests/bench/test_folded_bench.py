@@ -29,4 +29,5 @@ def test_the_states_a_search_expands_are_timed_with_the_heuristics_best_proposal
         assert len(v.picked) == len(v.zones) == 2 and v.features.shape[0] == 2
         assert sorted(scores[[v.proposals.index(p) for p in v.picked]]) == sorted(np.sort(scores)[-2:])
     t = time_graph(graph, SHIPPED_FOLDED, states=3, top_m=2, repeats=1)
-    assert t["states"] == len(seen) and min(t["network"], t["features"], t["heuristic"]) > 0
+    assert t["states"] == len(seen) and min(t["features"], t["heuristic"]) > 0
+    assert t["network"] > 0 if len(seen) > 1 else np.isnan(t["network"])

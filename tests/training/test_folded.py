@@ -12,7 +12,7 @@ import torch
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.network.checkpoint import SHIPPED, fold, fold_checkpoint, read_checkpoint
-from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State
+from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State, _max_elsewhere
 from zonegraph.network.model import ModelConfig, ProposalScorer
 from zonegraph.network.ranker import NetworkRanker, NumpyScorer, open_scorer
 from zonegraph.network.scoring import TorchScorer
@@ -371,3 +371,14 @@ def test_a_state_s_codes_updated_from_the_last_state_are_its_codes_computed_afre
             for mine, theirs in zip(codes.layers, fresh.layers, strict=True):
                 np.testing.assert_allclose(mine, theirs, atol=1e-6)
     assert updated, "every step computed every zone: the update was never tested"
+
+
+def test_the_greatest_code_a_proposal_left_untouched_is_found_among_each_channels_best_zones():
+    rng = np.random.default_rng(0)
+    codes = rng.normal(size=(40, 6)).astype(np.float32)
+    reached = rng.random((30, 40)) < np.linspace(0.0, 1.0, 30)[:, None]  # none reached ... all
+    reached[-1] = True
+    reached[5, np.argsort(-codes[:, 2])[:20]] = True  # every one of channel 2's best 16 zones
+    expected = np.stack([codes[~r].max(axis=0) if (~r).any() else np.full(6, -np.inf) for r in reached])
+    for top in (1, 16, 40):
+        np.testing.assert_array_equal(_max_elsewhere(codes, reached, top), expected)

@@ -434,15 +434,22 @@ def _mean_at(
     return matrix @ x
 
 
-def _max_elsewhere(codes: np.ndarray, reached: np.ndarray) -> np.ndarray:
+def _max_elsewhere(codes: np.ndarray, reached: np.ndarray, top: int = 16) -> np.ndarray:
     """(P, H) per proposal the greatest code of each channel over the zones it did not reach,
-    from the state's (Z, H) ``codes`` (-inf where it reached every zone): the channel's greatest
-    zone, unless the proposal reached it."""
-    top = codes.argmax(axis=0)  # (H,)
-    best = np.broadcast_to(codes[top, np.arange(codes.shape[1])], (len(reached), codes.shape[1])).copy()
-    taken = np.flatnonzero(reached[:, top].any(axis=1))
-    if len(taken):
-        best[taken] = np.where(reached[taken, :, None], -np.inf, codes[None]).max(axis=1)
+    from the state's (Z, H) ``codes`` (-inf where it reached every zone): of each channel's
+    ``top`` greatest zones, the first the proposal did not reach; the whole graph only for a
+    channel whose ``top`` it reached all of."""
+    z, h = codes.shape
+    t = min(top, z)
+    best_zones = np.argpartition(-codes, t - 1, axis=0)[:t] if t < z else np.argsort(-codes, axis=0)
+    values = np.take_along_axis(codes, best_zones, axis=0)
+    order = np.argsort(-values, axis=0, kind="stable")
+    best_zones, values = np.take_along_axis(best_zones, order, 0), np.take_along_axis(values, order, 0)
+    free = ~reached[:, best_zones]  # (P, t, H)
+    best = values[free.argmax(axis=1), np.arange(h)]
+    for k in np.flatnonzero((~free.any(axis=1)).any(axis=1)):
+        rest = codes[~reached[k]]
+        best[k] = rest.max(axis=0) if len(rest) else -np.inf
     return best
 
 
