@@ -441,6 +441,15 @@ def expansion_figure(rows: list[dict]) -> dict:
     }
 
 
+FOLDED_FIELDS = ("zones", "states", "network", "features", "heuristic")
+
+
+def folded_figure(rows: list[dict]) -> dict:
+    """The folded-scorer benchmark: milliseconds per scored state of each graph (to set two
+    checkouts' runs side by side)."""
+    return {"designs": {r["design_id"]: {k: r[k] for k in FOLDED_FIELDS} for r in rows}}
+
+
 def startup_figure(results: Path) -> dict:
     """The start-up benchmark by part: each process's CPU, wall and peak memory per column (ours
     cold, ours handed to a server, the original), and the server's own start where it ran."""
@@ -477,6 +486,7 @@ FIGURES_OF = {
     "rank": rank_figure,
     "heavy": heavy_figure,
     "expansion": expansion_figure,
+    "folded": folded_figure,
 }
 
 

@@ -2,7 +2,7 @@
 
     python -m bench.folded_bench [--graphs data/zonegraphs/graphs] [--zones 60 130 250 500 1300 4000]
                                  [--designs ID ...] [--states 40] [--top-m 8] [--model PATH]
-                                 [--repeats 3]
+                                 [--repeats 3] [--out bench_out/folded]
 
 For each zone count, the saved zone graph (from a pipeline run) closest to it, or each of
 ``--designs``, is searched with the heuristic for up to ``--states`` expansions; the states it
@@ -13,7 +13,8 @@ states, as in search. The first state is scored untimed: it pays what a search p
 graph (the adjacency, every zone's codes). The least time of ``--repeats`` passes, one BLAS
 thread; ``heuristic ms`` is the heuristic's scoring of every proposal of the same states,
 ``features ms`` the proposal features the network reads. A graph the heuristic solves in one
-expansion has no state to time: name designs whose search backtracks.
+expansion has no state to time: name designs whose search backtracks. ``results.json`` is what
+``python -m bench.figures folded`` reads.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from bench.corpus import closest_graphs
+from bench.corpus import closest_graphs, write_results
 from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer
 from zonegraph.network.ranker import NumpyScorer
 from zonegraph.sequence.best_first import SearchConfig, search
@@ -136,11 +137,11 @@ def main() -> None:
     parser.add_argument("--top-m", type=int, default=8)
     parser.add_argument("--model", type=Path, default=SHIPPED_FOLDED)
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--out", type=Path, default=Path("bench_out/folded"))
     args = parser.parse_args()
     if not args.graphs.is_dir():
         raise SystemExit(f"{args.graphs}: no saved zone graphs (run the zonegraphs stage first)")
-    header = "| zones | states | network ms | features ms | heuristic ms | network / heuristic |"
-    print(header + "\n" + "|---" * 6 + "|")
+    rows = []
     if args.designs:
         folders = [args.graphs / d for d in args.designs]
         missing = [f.name for f in folders if not f.is_dir()]
@@ -150,12 +151,25 @@ def main() -> None:
         folders = list(closest_graphs(args.graphs, args.zones).values())
     for folder in folders:
         graph = load_zone_graph(folder, solids=False)
-        t = time_graph(graph, args.model, args.states, args.top_m, args.repeats)
-        print(
-            f"| {graph.n_zones} | {t['states']:.0f} | {t['network']:.2f} | {t['features']:.2f} | "
-            f"{t['heuristic']:.2f} | {t['network'] / t['heuristic']:.1f}x |",
-            flush=True,
+        rows.append({"design_id": folder.name, "zones": graph.n_zones} | time_graph(
+            graph, args.model, args.states, args.top_m, args.repeats
+        ))
+        print(f"  {folder.name}: {graph.n_zones} zones, {rows[-1]['network']:.2f} ms", flush=True)
+    write_results(rows, table(rows), args.out)
+
+
+def table(rows: list[dict]) -> str:
+    """Milliseconds per state by graph, as markdown."""
+    lines = [
+        "| design | zones | states | network ms | features ms | heuristic ms | network / heuristic |",
+        "|---" * 7 + "|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['design_id']} | {r['zones']} | {r['states']} | {r['network']:.2f} | {r['features']:.2f} | "
+            f"{r['heuristic']:.2f} | {r['network'] / r['heuristic']:.1f}x |"
         )
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

@@ -454,6 +454,25 @@ def expansion(records: list[dict]) -> str:
 EXPANSION_KEYS = ("first_expansion_cpu_s", "search_cpu_s", "exact", "expansions")
 
 
+def folded(records: list[dict]) -> str:
+    """Runs of the folded-scorer benchmark side by side (oldest first): per graph, by zone count,
+    the network's milliseconds per scored state in each run (``before → after``), and the last
+    run's features, heuristic and ratio."""
+    last = records[-1]["figure"]["designs"]
+    lines = [
+        "| design | zones | states | network ms per state | features ms | heuristic ms "
+        "| network / heuristic |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name in sorted(last, key=lambda d: last[d]["zones"]):
+        d = last[name]
+        runs = [r["figure"]["designs"].get(name) for r in records]
+        network = " → ".join("-" if r is None else f"{r['network']:.2f}" for r in runs)
+        cells = [str(d["zones"]), str(d["states"]), network, f"{d['features']:.2f}", f"{d['heuristic']:.2f}"]
+        lines.append(_row(name, [*cells, f"{d['network'] / d['heuristic']:.1f}x"]))
+    return "\n".join(lines) + "\n\nMeasured by:\n\n" + _sources(records)
+
+
 def _value(figures: dict | None, key: str) -> str:
     """One design's figure in a run, "-" where the run did not measure the design."""
     if figures is None:
@@ -584,6 +603,7 @@ RENDERERS: dict[str, Callable[[list[dict]], str]] = {
     "rank": rank,
     "heavy": heavy,
     "expansion": expansion,
+    "folded": folded,
     "pipeline-run": pipeline_run,
     "startup": startup,
     "cover": cover,

@@ -15,6 +15,7 @@ from bench.figures import (
     coverage_figure,
     expansion_figure,
     fault_figure,
+    folded_figure,
     fuzz_figure,
     guide_cost_figure,
     heavy_figure,
@@ -452,3 +453,25 @@ def test_the_expansion_figure_sets_two_runs_side_by_side():
     assert "| before | 2 | 2 | 0.5410 / 0.9722 / 1.080 (1.08) |" in table
     assert "| big | 1544 | 1.080 → 0.320 | 1.400 → 0.650 | True → True | 10 → 10 |" in table
     assert "| small | 6 | 0.002 → - |" in table
+
+
+def test_the_folded_figure_sets_two_runs_side_by_side_by_zone_count():
+    """Two checkouts' runs of bench.folded_bench: each graph's network milliseconds per state as
+    before → after ("-" where the first run lacks the graph), sorted by zones."""
+    rows = [
+        {"design_id": "big", "zones": 2989, "states": 40, "network": 20.46}
+        | {"features": 0.18, "heuristic": 0.2},
+        {"design_id": "small", "zones": 12, "states": 40, "network": 0.24}
+        | {"features": 0.09, "heuristic": 0.02},
+    ]
+    after = [rows[0] | {"network": 11.45}, rows[1] | {"network": 0.21}, rows[1] | {"design_id": "new"}]
+    records = [
+        {"name": n, "command": "python -m bench.folded_bench", "commit": c, "measured": "2026-12-07"}
+        | {"figure": folded_figure(r)}
+        for n, c, r in (("before", "2ab9fcf", rows[:2]), ("after", "b732bd3", after))
+    ]
+    table = _hook().folded(records)
+    lines = table.splitlines()
+    assert lines[2].startswith("| small | 12 | 40 | 0.24 → 0.21 | 0.09 | 0.02 | 10.5x |")
+    assert "| new | 12 | 40 | - → 0.24 |" in table
+    assert lines[4] == "| big | 2989 | 40 | 20.46 → 11.45 | 0.18 | 0.20 | 57.2x |"
