@@ -447,7 +447,8 @@ def _max_elsewhere(codes: np.ndarray, reached: np.ndarray, top: int = 16) -> np.
     best_zones, values = np.take_along_axis(best_zones, order, 0), np.take_along_axis(values, order, 0)
     free = ~reached[:, best_zones]  # (P, t, H)
     best = values[free.argmax(axis=1), np.arange(h)]
-    for k in np.flatnonzero((~free.any(axis=1)).any(axis=1)):
+    blocked = np.logical_not(np.any(free, axis=1))  # (P, H): every one of the channel's top reached
+    for k in np.flatnonzero(np.any(blocked, axis=1)):
         rest = codes[~reached[k]]
         best[k] = rest.max(axis=0) if len(rest) else -np.inf
     return best
