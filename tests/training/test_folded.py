@@ -12,7 +12,7 @@ import torch
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.network.checkpoint import SHIPPED, fold, fold_checkpoint, read_checkpoint
-from zonegraph.network.folded import SHIPPED_FOLDED, FoldedScorer, State, _max_elsewhere
+from zonegraph.network.folded import SHIPPED_FOLDED, CodeMemo, FoldedScorer, State, _max_elsewhere
 from zonegraph.network.model import ModelConfig, ProposalScorer
 from zonegraph.network.ranker import NetworkRanker, NumpyScorer, open_scorer
 from zonegraph.network.scoring import TorchScorer
@@ -356,19 +356,27 @@ def test_a_guide_with_a_call_budget_takes_the_heuristics_order_once_it_is_spent(
 
 
 @requires_samples
-def test_a_state_s_codes_updated_from_the_last_state_are_its_codes_computed_afresh(states):
+def test_a_state_s_codes_updated_from_the_last_state_are_its_codes_computed_afresh(states, monkeypatch):
+    monkeypatch.setattr(FoldedScorer, "_reach", _forced_within_reach)
     folded = fold(_trained_like(ModelConfig(use_points=False, features=FEATURES)))
     updated = 0
     for graph, canvas, proposals in states:
         state = State.of(graph.zone_inside, canvas, graph.edges.astype(np.int64))
-        walk = [canvas] + [p.apply(canvas) for p in proposals[:6]] + [canvas]
-        codes = folded.state_codes(state, None)
+        walk = [canvas] + [p.apply(canvas) for p in proposals[:6]] + [canvas, canvas]
+        zones = np.stack([p.zones for p in proposals[:4]]).astype(bool)
+        ops = np.array([1 if p.op is Op.UNION else -1 for p in proposals[:4]], np.float32)
+        memo = CodeMemo()
         for before, after in itertools.pairwise(walk):
-            previous = folded.state_codes(state.with_canvas(before), None)
-            updated += folded._update_reach(state.with_canvas(after), previous) is not None
-            codes = folded.state_codes(state.with_canvas(after), None, codes)
-            fresh = folded.state_codes(state.with_canvas(after), None)
-            for mine, theirs in zip(codes.layers, fresh.layers, strict=True):
+            folded.score(state.with_canvas(before), zones, ops, memo=memo)
+            last = memo.last
+            assert last is not None
+            updated += folded._update_reach(state.with_canvas(after), last) is not None
+            kept = folded.score(state.with_canvas(after), zones, ops, memo=memo)
+            fresh_memo = CodeMemo()
+            fresh = folded.score(state.with_canvas(after), zones, ops, memo=fresh_memo)
+            np.testing.assert_allclose(kept, fresh, atol=1e-6)
+            assert memo.last is not None and fresh_memo.last is not None
+            for mine, theirs in zip(memo.last.layers, fresh_memo.last.layers, strict=True):
                 np.testing.assert_allclose(mine, theirs, atol=1e-6)
     assert updated, "every step computed every zone: the update was never tested"
 

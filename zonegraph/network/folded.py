@@ -136,7 +136,7 @@ class FoldedScorer:
         computed (`_pool_every_zone`). Exact either way: an untouched zone's code *is* the state's.
         The state's own codes change between two states of a search only within reach of the zones
         whose canvas flag differs, so with a ``memo`` of the graph's last state they are updated
-        there (`state_codes`) rather than computed again.
+        there rather than computed again, in the same products as the proposals' codes.
 
         Shapes:
             zones: (P, Z) bool, the extrusions; ops: (P,) +1 union, -1 subtract; geometry: (Z, H)
@@ -148,10 +148,10 @@ class FoldedScorer:
         if reach is None:
             pooled = self._pool_every_zone(state, extrusion, geometry)
         else:
-            codes = self.state_codes(state, geometry, memo.last if memo else None)
+            last = memo.last if memo else None
+            pooled, codes = self._pool_within_reach(state, extrusion, geometry, reach, last)
             if memo is not None:
                 memo.last = codes
-            pooled = self._pool_within_reach(state, extrusion, geometry, reach, codes)
         if self.columns:
             p = len(zones)
             taken = np.zeros((p, max(self.columns) + 1), np.float32) if features is None else features
@@ -217,36 +217,6 @@ class FoldedScorer:
             x = _round(chain, x.reshape(p * z, -1), mean.reshape(p * z, -1)).reshape(p, z, -1)
         return x.max(axis=1)
 
-    def state_codes(
-        self, state: State, geometry: np.ndarray | None, previous: StateCodes | None = None
-    ) -> StateCodes:
-        """Every zone's code at the state's canvas with no extrusion, after ``zone_in`` and each
-        round; from ``previous`` (the same graph at another canvas) only the zones within reach of
-        a changed flag are computed, unless they are half the graph or more."""
-        z = len(state.canvas)
-        if previous is not None and np.array_equal(state.canvas, previous.canvas):
-            return previous
-        reach = None if previous is None else self._update_reach(state, previous)
-        if previous is None or reach is None:
-            layers = [self._entry(state.inside, state.canvas, np.zeros(z, np.int64), geometry)]
-            for chain in self.rounds:
-                layers.append(_round(chain, layers[-1], state.neighbours @ layers[-1]))
-            return StateCodes(state.canvas, tuple(layers))
-        rows = np.flatnonzero(reach[0])
-        first = previous.layers[0].copy()
-        unchanged = np.zeros(len(rows), np.int64)  # no extrusion
-        first[rows] = self._entry(
-            state.inside[rows], state.canvas[rows], unchanged, None if geometry is None else geometry[rows]
-        )
-        layers = [first]
-        for chain, mask, before in zip(self.rounds, reach[1:], previous.layers[1:], strict=True):
-            rows = np.flatnonzero(mask)
-            mean = _mean_at(state.links, rows, layers[-1])
-            layer = before.copy()
-            layer[rows] = _round(chain, layers[-1][rows], mean)
-            layers.append(layer)
-        return StateCodes(state.canvas, tuple(layers))
-
     def _update_reach(self, state: State, previous: StateCodes) -> list[np.ndarray] | None:
         """(Z,) per layer: the zones whose codes differ from ``previous``'s, or None where they
         are half the graph or more (computing every zone costs less there)."""
@@ -259,29 +229,46 @@ class FoldedScorer:
         extrusion: np.ndarray,
         geometry: np.ndarray | None,
         reach: list[np.ndarray],
-        codes: StateCodes,
-    ) -> np.ndarray:
-        """(P, H) each proposal's zone codes pooled: the state's ``codes`` where a proposal left a
-        zone's code as it is, computed within its reach.
+        previous: StateCodes | None = None,
+    ) -> tuple[np.ndarray, StateCodes]:
+        """(P, H) each proposal's zone codes pooled, and the state's own codes: a proposal's
+        codes are the state's where it left a zone's code as it is, computed within its reach;
+        the state's are ``previous``'s (the same graph at another canvas) but where a changed flag
+        reaches, or every zone's.
 
-        A layer's codes are the state's (rows ``0 .. Z-1``) and then the proposals' reached zones
-        in the order of `np.nonzero`; ``where`` (P, Z) holds the row of each proposal's code of each
-        zone, so one sparse product gives every reached zone's neighbour mean."""
+        In each round one sparse product gives the neighbour mean of every zone computed, the
+        state's first: a layer's codes are the state's (rows ``0 .. Z-1``) and then the
+        proposals' reached zones in the order of `np.nonzero`, and ``where`` (P + 1, Z) holds the
+        row of each one's code of each zone (the last row, the state's own)."""
         p, z = extrusion.shape
+        changed = None if previous is None else self._update_reach(state, previous)
+        update = [np.arange(z)] * len(reach) if changed is None else [np.flatnonzero(m) for m in changed]
+        base = None if changed is None or previous is None else previous.layers
         pk, pz = np.nonzero(reach[0])
+        rows = update[0]
         own = self._entry(
-            state.inside[pz], state.canvas[pz], extrusion[pk, pz], None if geometry is None else geometry[pz]
+            np.concatenate([state.inside[rows], state.inside[pz]]),
+            np.concatenate([state.canvas[rows], state.canvas[pz]]),
+            np.concatenate([np.zeros(len(rows), np.int64), extrusion[pk, pz]]),
+            None if geometry is None else geometry[np.concatenate([rows, pz])],
         )
-        where = np.tile(np.arange(z, dtype=np.int32), (p, 1))
-        for chain, mask, before in zip(self.rounds, reach[1:], codes.layers[:-1], strict=True):
+        layers = [_updated(base[0] if base else None, rows, own[: len(rows)])]
+        own = own[len(rows) :]
+        where = np.tile(np.arange(z, dtype=np.int32), (p + 1, 1))
+        for layer, (chain, mask) in enumerate(zip(self.rounds, reach[1:], strict=True), 1):
             where[pk, pz] = z + np.arange(len(pk))  # a round reaches every zone the one before did
             pk, pz = np.nonzero(mask)
-            x = np.concatenate([before, own])
-            own = _round(chain, x[where[pk, pz]], _mean_at(state.links, pz, x, where, pk))
+            rows = update[layer]
+            zones, owners = np.concatenate([rows, pz]), np.concatenate([np.full(len(rows), p), pk])
+            x = np.concatenate([layers[-1], own])
+            out = _round(chain, x[where[owners, zones]], _mean_at(state.links, zones, x, where, owners))
+            layers.append(_updated(base[layer] if base else None, rows, out[: len(rows)]))
+            own = out[len(rows) :]
         pooled = np.full((p, own.shape[1]), -np.inf, np.float32)
         firsts = np.flatnonzero(np.diff(pk, prepend=-1))  # each proposal's first reached zone
         pooled[pk[firsts]] = np.maximum.reduceat(own, firsts, axis=0)
-        return np.maximum(pooled, _max_elsewhere(codes.layers[-1], reach[-1]))
+        codes = StateCodes(state.canvas, tuple(layers))
+        return np.maximum(pooled, _max_elsewhere(layers[-1], reach[-1])), codes
 
     def save(self, path: str | Path) -> None:
         """Writes the configuration and every layer's arrays as one ``.npz`` (no pickled objects):
@@ -411,6 +398,16 @@ def _round(chain: Chain, x: np.ndarray, mean: np.ndarray) -> np.ndarray:
     y += mean @ first.weight[h:]
     y += first.bias
     return run(chain[1:], _activate(y, first))
+
+
+def _updated(before: np.ndarray | None, rows: np.ndarray, codes: np.ndarray) -> np.ndarray:
+    """A layer of the state's codes: ``codes`` at ``rows`` and ``before`` elsewhere (``codes``
+    themselves where there is no layer before, every zone computed)."""
+    if before is None:
+        return codes
+    layer = before.copy()
+    layer[rows] = codes
+    return layer
 
 
 def _mean_at(
