@@ -52,26 +52,33 @@ class Visit:
 
 
 class Recorder(HeuristicRanker):
-    """The heuristic, keeping every state it is asked to score (each expansion asks once)."""
+    """The heuristic, keeping every state it is asked to score (each expansion asks once) with
+    its scores."""
 
     def __init__(self) -> None:
-        self.seen: list[tuple[np.ndarray, list[Proposal]]] = []
+        self.seen: list[tuple[np.ndarray, list[Proposal], np.ndarray]] = []
 
     def score(self, graph: ZoneGraph, canvas: np.ndarray, proposals: list[Proposal]) -> np.ndarray:
-        self.seen.append((canvas.copy(), proposals))
-        return super().score(graph, canvas, proposals)
+        scores = super().score(graph, canvas, proposals)
+        self.seen.append((canvas.copy(), proposals, scores))
+        return scores
+
+
+# Expansions the recording search may make per state kept: states of one proposal are skipped,
+# and the search stops there rather than at its budget on a design it cannot solve.
+EXPANSIONS_PER_STATE = 10
 
 
 def visits(graph: ZoneGraph, states: int, top_m: int) -> list[Visit]:
     """The first ``states`` states a heuristic search of ``graph`` expands with more than one
     proposal (a state with one is never scored)."""
     recorder = Recorder()
-    search(graph, recorder, SearchConfig(budget_s=60.0, max_depth=20), ProposalGenerator(graph))
+    config = SearchConfig(budget_s=60.0, max_depth=20, max_expansions=EXPANSIONS_PER_STATE * states)
+    search(graph, recorder, config, ProposalGenerator(graph))
     on_target, out = target_surfaces(graph), []
-    for canvas, proposals in recorder.seen:
+    for canvas, proposals, scores in recorder.seen:
         if len(proposals) < 2:
             continue
-        scores = HeuristicRanker().score(graph, canvas, proposals)
         picked = [proposals[i] for i in np.sort(np.argsort(-scores, kind="stable")[:top_m])]
         zones = np.stack([p.zones for p in picked]).astype(bool)
         ops = np.array([1 if p.op is Op.UNION else -1 for p in picked], np.float32)
@@ -99,6 +106,7 @@ def time_graph(graph: ZoneGraph, model: Path, states: int, top_m: int, repeats: 
     on_target = target_surfaces(graph)
 
     scorer = NumpyScorer(folded)
+    spent: list[float] = []  # seconds of each timed pass
 
     def network() -> None:
         first = seen[0]  # back to the first state, untimed (as a search's set-up, once per graph)
@@ -116,7 +124,6 @@ def time_graph(graph: ZoneGraph, model: Path, states: int, top_m: int, repeats: 
         for v in seen:
             HeuristicRanker().score(graph, v.canvas, v.proposals)
 
-    spent: list[float] = []
     with threadpool_limits(limits=1, user_api="blas"):
         for _ in range(repeats):
             network()

@@ -242,8 +242,10 @@ class FoldedScorer:
         row of each one's code of each zone (the last row, the state's own)."""
         p, z = extrusion.shape
         changed = None if previous is None else self._update_reach(state, previous)
-        update = [np.arange(z)] * len(reach) if changed is None else [np.flatnonzero(m) for m in changed]
-        base = None if changed is None or previous is None else previous.layers
+        if changed is None or previous is None:  # every zone of the state computed
+            update, base = [np.arange(z)] * len(reach), None
+        else:
+            update, base = [np.flatnonzero(m) for m in changed], previous.layers
         pk, pz = np.nonzero(reach[0])
         rows = update[0]
         own = self._entry(
@@ -411,22 +413,16 @@ def _updated(before: np.ndarray | None, rows: np.ndarray, codes: np.ndarray) -> 
 
 
 def _mean_at(
-    links: sp.csr_matrix,
-    zones: np.ndarray,
-    x: np.ndarray,
-    where: np.ndarray | None = None,
-    owners: np.ndarray | None = None,
+    links: sp.csr_matrix, zones: np.ndarray, x: np.ndarray, where: np.ndarray, owners: np.ndarray
 ) -> np.ndarray:
-    """(N, H) the neighbour mean of N ``zones``, each neighbour's code read from its row of
-    ``x``: the zone's own row, or with ``where`` (P, Z) row ``where[owners[i], zone]``. The
-    product's index arrays are 32-bit, as scipy's own: it checks 64-bit ones at twice the cost."""
+    """(N, H) the neighbour mean of N ``zones``, the i-th zone's neighbour ``j`` read from row
+    ``where[owners[i], j]`` of ``x``. The product's index arrays are 32-bit, as scipy's own: it
+    checks 64-bit ones at twice the cost."""
     counts = np.diff(links.indptr)[zones]
     indptr = np.zeros(len(zones) + 1, np.int32)
     np.cumsum(counts, out=indptr[1:])
     at = np.repeat(links.indptr[zones] - indptr[:-1], counts) + np.arange(indptr[-1], dtype=np.int32)
-    columns = links.indices[at]
-    if where is not None and owners is not None:
-        columns = where[np.repeat(owners, counts), columns]
+    columns = where[np.repeat(owners, counts), links.indices[at]]
     matrix = sp.csr_matrix((links.data[at], columns.astype(np.int32), indptr), shape=(len(zones), len(x)))
     return matrix @ x
 
