@@ -159,9 +159,9 @@ def main() -> None:
     source, limit = data.source, data.limit
     seed, fraction = data.split_seed, data.test_fraction
     if source == "fusion_json":
-        folder = Path(_folder(data.fusion_json_dir, "fusion_json_dir")).expanduser().resolve()
+        folder = _folder(data.fusion_json_dir, "fusion_json_dir")
     elif source == "b123d":
-        root = Path(_folder(data.b123d_dir, "b123d_dir")).expanduser().resolve()
+        root = _folder(data.b123d_dir, "b123d_dir")
         table = convert_corpus(root, limit, data.limit_seed, dask, data.convert_timeout_s, args.out)
         write_conversion(table, args.out, args.metrics, args.details)
         folder = args.out / "json"
@@ -185,10 +185,17 @@ def main() -> None:
     print(f"generate: {len(records)} designs from {folder} ({source})")
 
 
-def _folder(value: str | None, key: str) -> str:
+def _folder(value: str | None, key: str) -> Path:
+    """The source folder ``data.<key>`` names, resolved from the run's folder (the one holding
+    ``params.yaml``, where DVC runs the stage): a missing one is a user's error, said in one line."""
     if value is None:
         raise SystemExit(f"{PARAMS_FILE}: data: this source needs data.{key}")
-    return value
+    folder = Path(value).expanduser().resolve()
+    if not folder.is_dir():
+        raise SystemExit(
+            f"{PARAMS_FILE}: data.{key}: no folder {folder} (a relative path is read from {Path.cwd()})"
+        )
+    return folder
 
 
 def write_index(records: list[DesignRecord], table: pd.DataFrame | None, out: Path) -> None:
