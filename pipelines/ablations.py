@@ -56,7 +56,7 @@ CHANGES: dict[str, dict[str, Any]] = {  # a variant's tokens, as overrides of th
 }
 
 
-def variant(base: TrainConfig, spec: str, teacher: str | None = None) -> TrainConfig:
+def variant(base: TrainConfig, spec: str, teacher: tuple[str, ...] = ()) -> TrainConfig:
     """The base with the changes of ``spec`` (``base``, or tokens of `CHANGES`, ``roundsN``,
     ``hiddenN`` and ``teacher`` joined by ``+``); an unknown token exits with one line."""
     config = base
@@ -69,7 +69,7 @@ def variant(base: TrainConfig, spec: str, teacher: str | None = None) -> TrainCo
         elif hidden:
             config = replace(config, hidden=int(hidden.group(1)))
         elif token == "teacher":
-            if teacher is None:
+            if not teacher:
                 raise SystemExit(
                     f"ablations: {spec!r} learns from a teacher: name its checkpoint with --teacher"
                 )
@@ -133,7 +133,8 @@ def same_settings(stamp: str, wanted: str) -> bool:
 def describe(config: TrainConfig) -> str:
     features = f"{len(config.features)} features" if config.features else "no features"
     points = "points" if config.use_points else "no points"
-    taught = f", {config.distill:g} taught by {Path(config.teacher).name}" if config.teacher else ""
+    names = " + ".join(Path(t).name for t in config.teacher)
+    taught = f", {config.distill:g} taught by {names}" if config.teacher else ""
     return (
         f"{config.loss}, {features}, {config.fusion} fusion, {points}, {config.rounds} rounds, "
         f"hidden {config.hidden}{taught}"
@@ -177,7 +178,9 @@ def main() -> None:
     parser.add_argument(
         "--compare", nargs="*", default=[], help="other checkpoints ranked beside them: PATH[@knob=value,...]"
     )
-    parser.add_argument("--teacher", default=None, help="the checkpoint a `teacher` variant learns from")
+    parser.add_argument(
+        "--teacher", nargs="+", default=[], help="the checkpoints a `teacher` variant learns from"
+    )
     parser.add_argument("--labels", default=None, help="the labels folder (default: params)")
     parser.add_argument("--graphs", default=None, help="the zone graphs folder (default: params)")
     parser.add_argument(
@@ -195,7 +198,7 @@ def main() -> None:
     base = replace(base, **{k: v for k, v in (("labels_dir", args.labels), ("graphs_dir", args.graphs)) if v})
     args.out.mkdir(parents=True, exist_ok=True)
     specs = args.variants or default_specs(base, args.rounds)
-    chosen = {spec: variant(base, spec, args.teacher) for spec in specs}
+    chosen = {spec: variant(base, spec, tuple(args.teacher)) for spec in specs}
     models = [train_variant(name, config, args.out) for name, config in chosen.items()]
     compared = list(args.compare)  # checkpoints, each may carry the guide's knobs (PATH@top_m=8)
     seen, _ = trained_projects([*models, *(c.partition("@")[0] for c in compared)])

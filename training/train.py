@@ -35,6 +35,7 @@ import socket
 import subprocess
 import threading
 import time
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -58,6 +59,7 @@ from zonegraph.sequence.rankers import GTPlace, gt_place
 DEFAULT_TRACKING = "sqlite:///mlflow.db"
 LAST = "last.pt"  # the resumable state, beside the best checkpoint
 SELECT = "val_normalised"  # the validation metric that picks the best epoch (lower is better)
+Teachers = tuple[ProposalScorer, ...]
 
 
 @dataclass(frozen=True)
@@ -79,7 +81,8 @@ class TrainConfig(Config):
     features: tuple[str, ...] = ()  # proposal features the scorer reads (zonegraph.sequence.features)
     loss: str = "focal"  # focal (per proposal) or listwise (softmax over a state's proposals)
     neutral_credit: float | None = None  # listwise: None leaves neutrals out, else their target weight
-    teacher: str | None = None  # listwise: a trained checkpoint whose scores share the target
+    # listwise: trained checkpoints whose mean log-odds share the target (one, or an ensemble)
+    teacher: tuple[str, ...] = ()
     distill: float = 0.5  # the teacher's share of each state's target (with a teacher)
     temperature: float = 2.0  # of the teacher's softmax
     epochs: int = 3
@@ -101,6 +104,13 @@ class TrainConfig(Config):
     device: str = "cpu"  # cpu, cuda, or auto (cuda when available)
     experiment: str = "zonegraph-scorer"
 
+    @classmethod
+    def from_mapping(cls, values: Mapping[str, Any], strict: bool = False) -> TrainConfig:
+        """As `Config.from_mapping`, with ``teacher`` one checkpoint's path or a list of them."""
+        if isinstance(values.get("teacher"), str):
+            values = {**values, "teacher": [values["teacher"]]}
+        return super().from_mapping(values, strict)
+
     @property
     def model(self) -> ModelConfig:
         return ModelConfig(
@@ -121,10 +131,11 @@ class TrainConfig(Config):
             self.model.feature_columns()
         except ValueError as exc:
             raise SystemExit(f"train: {exc}") from None
-        if self.teacher is not None and (self.loss != "listwise" or not 0.0 <= self.distill <= 1.0):
+        if self.teacher and (self.loss != "listwise" or not 0.0 <= self.distill <= 1.0):
             raise SystemExit("train: a teacher shares the listwise target: loss listwise, distill in [0, 1]")
-        if self.teacher is not None and not Path(self.teacher).is_file():
-            raise SystemExit(f"train: {self.teacher}: no teacher checkpoint")
+        for path in self.teacher:
+            if not Path(path).is_file():
+                raise SystemExit(f"train: {path}: no teacher checkpoint")
         if not 0.0 <= self.holdout_fraction < 1.0:
             raise SystemExit("train: holdout_fraction is a share of the training projects, in [0, 1)")
         if self.device == "cuda" and not torch.cuda.is_available():
@@ -143,32 +154,41 @@ def forward(model: ProposalScorer, batch: Any) -> torch.Tensor:
 
 
 def objective(
-    config: TrainConfig, logits: torch.Tensor, batch: Any, teacher: ProposalScorer | None = None
+    config: TrainConfig, logits: torch.Tensor, batch: Any, teacher: Teachers = ()
 ) -> torch.Tensor:
-    """The configured loss of one batch (with a teacher, its scores share the listwise target)."""
+    """The configured loss of one batch (with teachers, their mean logits share the listwise
+    target: the mean of each column, so their mean log-odds)."""
     if config.loss == "focal":
         keep = batch.label != 0  # neutrals kept for a listwise loss carry no focal signal
         return focal_loss(logits[keep], batch.y[keep], config.gamma)
     weight = (batch.label == 1).float()
     if config.neutral_credit:
         weight = weight + config.neutral_credit * (batch.label == 0).float()
-    if teacher is not None:
-        with torch.no_grad():
-            taught = forward(teacher, batch)
+    if teacher:
+        taught = teach(teacher, batch)
         weight = distilled_weight(weight, taught, batch.state, config.distill, config.temperature)
     return listwise_loss(logits, batch.state, weight)
 
 
-def load_teacher(config: TrainConfig, device: torch.device) -> tuple[ProposalScorer | None, list[str]]:
-    """The teacher in eval mode and the projects it trained on (a student has seen them too:
-    evaluation leaves them out), or None and no projects."""
-    if config.teacher is None:
-        return None, []
-    checkpoint = read_checkpoint(config.teacher, str(device))
-    teacher = scorer_from(checkpoint, str(device))
-    if teacher.config.use_points and not config.use_points:
-        raise SystemExit(f"train: {config.teacher}: the teacher reads point geometry; train with use_points")
-    return teacher, list(checkpoint.get("provenance", {}).get("train_projects", []))
+def teach(teachers: Teachers, batch: Any) -> torch.Tensor:
+    """(P, 2) the teachers' mean logits: their difference is the mean of the teachers' log-odds,
+    an ensemble's score (one teacher: its own logits)."""
+    with torch.no_grad():
+        return torch.stack([forward(t, batch) for t in teachers]).mean(dim=0)
+
+
+def load_teacher(config: TrainConfig, device: torch.device) -> tuple[Teachers, list[str]]:
+    """The teachers in eval mode and every project one of them trained on (a student has seen
+    them too: evaluation leaves them out); none and no projects without a teacher."""
+    teachers, projects = [], set()
+    for path in config.teacher:
+        checkpoint = read_checkpoint(path, str(device))
+        teacher = scorer_from(checkpoint, str(device))
+        if teacher.config.use_points and not config.use_points:
+            raise SystemExit(f"train: {path}: the teacher reads point geometry; train with use_points")
+        teachers.append(teacher)
+        projects |= set(checkpoint.get("provenance", {}).get("train_projects", []))
+    return tuple(teachers), sorted(projects)
 
 
 def mean_loss(
@@ -176,7 +196,7 @@ def mean_loss(
     loader: DataLoader,
     device: torch.device,
     config: TrainConfig,
-    teacher: ProposalScorer | None = None,
+    teacher: Teachers = (),
 ) -> float:
     model.eval()
     total, count = 0.0, 0
@@ -246,7 +266,8 @@ def run_name(config: TrainConfig, train_designs: int) -> str:
     """What the dashboard lists: the fusion, the objective, the data and the seed."""
     features = " +features" if config.features else ""
     width = f" hidden{config.hidden}" if config.hidden != HIDDEN else ""
-    taught = f" +teacher{config.distill:g}" if config.teacher else ""
+    many = f"x{len(config.teacher)}" if len(config.teacher) > 1 else ""
+    taught = f" +teacher{many}{config.distill:g}" if config.teacher else ""
     return f"{config.fusion} {config.loss}{features}{width}{taught} {train_designs} designs seed{config.seed}"
 
 
@@ -350,7 +371,8 @@ def resume_key(config: TrainConfig, version: str) -> dict[str, Any]:
     """What a resumed run must share with the one it continues: every setting but the epoch
     count and the device, and the labels."""
     settings = {k: v for k, v in asdict(config).items() if k not in ("epochs", "device")}
-    return {**settings, "features": list(config.features), "data_version": version}
+    lists = {"features": list(config.features), "teacher": list(config.teacher)}
+    return {**settings, **lists, "data_version": version}
 
 
 def load_last(path: Path, key: dict[str, Any], epochs: int) -> dict[str, Any] | None:
@@ -434,8 +456,8 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     holdout = sorted({project_of(d) for d in split.holdout})
     if overlap := set(taught) & set(holdout):
         raise SystemExit(
-            f"train: {config.teacher}: the teacher trained on {len(overlap)} of the held-out projects: "
-            "train it with the same holdout_fraction and holdout_seed"
+            f"train: {', '.join(config.teacher)}: the teacher trained on {len(overlap)} of the held-out "
+            "projects: train it with the same holdout_fraction and holdout_seed"
         )
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
     out = Path(config.out_dir)

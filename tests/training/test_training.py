@@ -283,8 +283,8 @@ def test_an_ablation_variant_is_the_base_with_its_changes_each_alone_and_combine
     assert "listwise+features+early" in specs and "rounds3" not in specs
     with pytest.raises(SystemExit, match="unknown change 'deep'"):
         variant(base, "listwise+deep")
-    student = variant(base, "listwise+hidden48+teacher", teacher="teacher.pt")
-    assert (student.hidden, student.teacher, student.model.hidden) == (48, "teacher.pt", 48)
+    student = variant(base, "listwise+hidden48+teacher", teacher=("teacher.pt",))
+    assert (student.hidden, student.teacher, student.model.hidden) == (48, ("teacher.pt",), 48)
     with pytest.raises(SystemExit, match="--teacher"):
         variant(base, "listwise+teacher")
 
@@ -336,20 +336,36 @@ def test_a_narrow_student_learns_from_a_teacher_folds_and_owns_its_projects(labe
     teacher = read_checkpoint(tmp_path / "teacher" / "scorer.pt")
     teacher["provenance"]["train_projects"].append("elsewhere")  # a project only the teacher saw
     torch.save(teacher, tmp_path / "teacher" / "scorer.pt")
-    train(
-        _quick(
-            labelled, **common, out_dir="student", hidden=16, teacher=str(tmp_path / "teacher" / "scorer.pt")
-        )
-    )
+    train(_quick(labelled, **common, out_dir="second", seed=1))
+    second = read_checkpoint(tmp_path / "second" / "scorer.pt")
+    second["provenance"]["train_projects"].append("only-the-second")
+    torch.save(second, tmp_path / "second" / "scorer.pt")
+    teachers = (str(tmp_path / "teacher" / "scorer.pt"), str(tmp_path / "second" / "scorer.pt"))
+    train(_quick(labelled, **common, out_dir="student", hidden=16, teacher=teachers))
     student = read_checkpoint(tmp_path / "student" / "scorer.pt")
-    assert student["model"]["hidden"] == 16 and student["train"]["teacher"].endswith("teacher/scorer.pt")
-    assert "elsewhere" in student["provenance"]["train_projects"]
+    assert student["model"]["hidden"] == 16 and list(student["train"]["teacher"]) == list(teachers)
+    assert {"elsewhere", "only-the-second"} <= set(student["provenance"]["train_projects"])
     folded = fold_checkpoint(student)
     assert folded.rounds[0][0].weight.shape == (32, 16)
     with pytest.raises(SystemExit, match="loss listwise"):
         _quick(
-            labelled, **{**common, "loss": "focal"}, teacher=str(tmp_path / "teacher" / "scorer.pt")
+            labelled, **{**common, "loss": "focal"}, teacher=teachers
         ).check()
+    one = TrainConfig.from_mapping({"teacher": teachers[0]}, strict=True)  # params.yaml: one path
+    assert one.teacher == (teachers[0],)
+
+    # an ensemble teaches its mean logits, so its log-odds are the mean of its members'
+    from torch_geometric.loader import DataLoader
+
+    from training.train import forward, load_teacher, teach
+
+    (first, other), _ = load_teacher(_quick(labelled, **common, teacher=teachers), torch.device("cpu"))
+    data = LabelDataset(labelled / "labels", labelled / "graphs", mode="train", points_per_zone=16)
+    batch = next(iter(DataLoader(data, batch_size=4)))
+    with torch.no_grad():
+        one, two = forward(first, batch), forward(other, batch)
+    assert torch.allclose(teach((first,), batch), one) and torch.allclose(teach((first, first), batch), one)
+    assert torch.allclose(teach((first, other), batch), (one + two) / 2) and not torch.allclose(one, two)
 
 
 @requires_samples
@@ -446,7 +462,7 @@ def test_a_holdout_of_training_projects_is_never_trained_on_and_is_what_the_benc
     train(replace(config, out_dir="whole"))  # no holdout: nothing to evaluate on, said in one line
     with pytest.raises(SystemExit, match="no held-out projects"):
         holdout_projects([tmp_path / "whole" / "scorer.pt"])
-    taught = replace(config, out_dir="student", teacher=str(tmp_path / "whole" / "scorer.pt"))
+    taught = replace(config, out_dir="student", teacher=(str(tmp_path / "whole" / "scorer.pt"),))
     with pytest.raises(SystemExit, match="teacher trained on 1 of the held-out projects"):
         train(replace(taught, holdout_fraction=0.34, holdout_seed=3))
 
