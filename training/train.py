@@ -51,7 +51,9 @@ from training.loss import LOSSES, distilled_weight, focal_loss, listwise_loss
 from training.shards import label_shards
 from zonegraph.configs import Config, ConfigError, load_section
 from zonegraph.data.dataset import project_of, test_ids
-from zonegraph.network.checkpoint import read_checkpoint, scorer_from
+from zonegraph.network.checkpoint import fold, read_checkpoint, scorer_from
+from zonegraph.network.encoding import Geometry
+from zonegraph.network.folded import FoldedScorer, State
 from zonegraph.network.model import HIDDEN, ModelConfig, ProposalScorer
 from zonegraph.network.scoring import score_state
 from zonegraph.sequence.rankers import GTPlace, gt_place
@@ -209,23 +211,52 @@ def mean_loss(
     return total / max(count, 1)
 
 
-def rank_places(model: ProposalScorer, dataset: LabelDataset, device: torch.device) -> list[GTPlace]:
-    """The GT's place in every state of a rank-mode dataset (states with a GT and others)."""
+def rank_places(
+    model: ProposalScorer, dataset: LabelDataset, device: torch.device, numpy: bool = True
+) -> list[GTPlace]:
+    """The GT's place in every state of a rank-mode dataset (states with a GT and others).
+
+    On the CPU a late-fusion model is scored folded to numpy, as the guide runs it: a proposal's
+    codes are computed only within its reach (`zonegraph.network.folded`), where the PyTorch
+    forward computes every zone of every proposal, and a state of hundreds of proposals of a
+    16,500-zone graph made one validation pass of the whole-corpus labels outlast the epoch's
+    training. The same scores either way (tests compare the two forwards); ``numpy`` False keeps
+    the PyTorch forward."""
+    late_on_cpu = model.config.fusion == "late" and device.type == "cpu"
+    folded = fold(model) if numpy and late_on_cpu else None
+    numpy_states: dict[str, tuple[State, np.ndarray | None]] = {}
     places = []
     for state in dataset.states:
         if int(state.is_gt.sum()) != 1 or len(state.is_gt) < 2:
             continue
-        scores = score_state(
-            model,
-            dataset.geometry[state.design_id],
-            torch.from_numpy(state.canvas),
-            torch.from_numpy(state.zones),
-            torch.from_numpy(state.ops),
-            device,
-            features=torch.from_numpy(state.features),
-        )
+        geometry = dataset.geometry[state.design_id]
+        if folded is None:
+            scores = score_state(
+                model,
+                geometry,
+                torch.from_numpy(state.canvas),
+                torch.from_numpy(state.zones),
+                torch.from_numpy(state.ops),
+                device,
+                features=torch.from_numpy(state.features),
+            )
+        else:
+            if state.design_id not in numpy_states:
+                numpy_states[state.design_id] = _numpy_graph(folded, geometry)
+            graph, codes = numpy_states[state.design_id]
+            ops = state.ops.astype(np.float32)
+            scores = folded.score(graph.with_canvas(state.canvas), state.zones, ops, codes, state.features)
         places.append(gt_place(scores, state.is_gt))
     return places
+
+
+def _numpy_graph(folded: FoldedScorer, geometry: Geometry) -> tuple[State, np.ndarray | None]:
+    """A design's adjacency and zone geometry codes as the folded scorer reads them: its edges
+    once each (``edge_index`` holds both directions, the first half one of them)."""
+    edges = geometry.edge_index[:, : geometry.edge_index.shape[1] // 2].T.numpy()
+    inside = geometry.inside.numpy()
+    codes = folded.encode_geometry(geometry.points.numpy()) if folded.points else None
+    return State.of(inside, np.zeros(len(inside), bool), edges), codes
 
 
 def rank_metrics(places: list[GTPlace], prefix: str = "val_") -> dict[str, float]:

@@ -487,3 +487,23 @@ def test_holdouts_drawn_with_two_seeds_are_independent_draws_of_about_their_shar
     assert 0.13 < len(first) / len(projects) < 0.17 and 0.13 < len(second) / len(projects) < 0.17
     expected = len(first) * len(second) / len(projects)  # a CRC's draws shared none
     assert 0.6 * expected < len(first & second) < 1.4 * expected
+
+
+@requires_samples
+@pytest.mark.parametrize("use_points", [False, True])
+def test_validation_ranks_with_the_numpy_fold_as_with_the_pytorch_forward(
+    labelled, tmp_path, monkeypatch, use_points
+):
+    from training.train import rank_metrics, rank_places
+    from zonegraph.sequence.features import FEATURES
+
+    monkeypatch.chdir(tmp_path)
+    train(_quick(labelled, loss="listwise", features=FEATURES, use_points=use_points))
+    model = load_scorer(tmp_path / "models" / "scorer.pt")
+    data = LabelDataset(labelled / "labels", labelled / "graphs", mode="rank", points_per_zone=16)
+    cpu = torch.device("cpu")
+    folded, forward = rank_places(model, data, cpu), rank_places(model, data, cpu, numpy=False)
+    assert len(folded) == len(forward) > 5
+    assert [p.proposals for p in folded] == [p.proposals for p in forward]
+    assert [(p.above, p.ties) for p in folded] == [(p.above, p.ties) for p in forward]
+    assert rank_metrics(folded) == rank_metrics(forward)
