@@ -219,10 +219,9 @@ def rank_places(
 
     On the CPU a late-fusion model is scored folded to numpy, as the guide runs it: a proposal's
     codes are computed only within its reach (`zonegraph.network.folded`), where the PyTorch
-    forward computes every zone of every proposal, and a state of hundreds of proposals of a
-    16,500-zone graph made one validation pass of the whole-corpus labels outlast the epoch's
-    training. The same scores either way (tests compare the two forwards); ``numpy`` False keeps
-    the PyTorch forward."""
+    forward computes every zone of every proposal, which on a large graph with thousands of
+    proposals costs more than an epoch's training (docs/CHANGELOG.md). The same scores either way
+    (tests compare the two forwards); ``numpy`` False keeps the PyTorch forward."""
     late_on_cpu = model.config.fusion == "late" and device.type == "cpu"
     folded = fold(model) if numpy and late_on_cpu else None
     numpy_states: dict[str, tuple[State, np.ndarray | None]] = {}
