@@ -224,7 +224,7 @@ def rank_places(
     (tests compare the two forwards); ``numpy`` False keeps the PyTorch forward."""
     late_on_cpu = model.config.fusion == "late" and device.type == "cpu"
     folded = fold(model) if numpy and late_on_cpu else None
-    numpy_states: dict[str, tuple[State, np.ndarray | None]] = {}
+    design, graph = "", None  # the states come design by design: one design's graph at a time
     places = []
     for state in dataset.states:
         if int(state.is_gt.sum()) != 1 or len(state.is_gt) < 2:
@@ -241,9 +241,9 @@ def rank_places(
                 features=torch.from_numpy(state.features),
             )
         else:
-            if state.design_id not in numpy_states:
-                numpy_states[state.design_id] = _numpy_graph(folded, geometry)
-            scores = _numpy_scores(folded, *numpy_states[state.design_id], state)
+            if graph is None or state.design_id != design:
+                design, graph = state.design_id, _numpy_graph(folded, geometry)
+            scores = _numpy_scores(folded, *graph, state)
         places.append(gt_place(scores, state.is_gt))
     return places
 
@@ -263,12 +263,10 @@ def _numpy_scores(folded: FoldedScorer, graph: State, codes: np.ndarray | None, 
 
 
 def _numpy_graph(folded: FoldedScorer, geometry: Geometry) -> tuple[State, np.ndarray | None]:
-    """A design's adjacency and zone geometry codes as the folded scorer reads them: its edges
-    once each (``edge_index`` holds both directions, the first half one of them)."""
-    edges = geometry.edge_index[:, : geometry.edge_index.shape[1] // 2].T.numpy()
+    """A design's adjacency and zone geometry codes as the folded scorer reads them."""
     inside = geometry.inside.numpy()
     codes = folded.encode_geometry(geometry.points.numpy()) if folded.points else None
-    return State.of(inside, np.zeros(len(inside), bool), edges), codes
+    return State.of(inside, np.zeros(len(inside), bool), geometry.edges), codes
 
 
 def rank_metrics(places: list[GTPlace], prefix: str = "val_") -> dict[str, float]:

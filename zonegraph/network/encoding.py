@@ -42,6 +42,12 @@ class Geometry:
     def n_zones(self) -> int:
         return len(self.inside)
 
+    @property
+    def edges(self) -> np.ndarray:
+        """(E / 2, 2) each adjacency once, as the zone graph lists it (`geometry_of` writes
+        ``edge_index`` as those edges and then the same edges reversed)."""
+        return self.edge_index[:, : self.edge_index.shape[1] // 2].T.numpy()
+
 
 def geometry_of(graph: ZoneGraph, points_per_zone: int | None = None, seed: int = 0) -> Geometry:
     """The network's view of a zone graph, optionally keeping a seeded subset of the samples."""
