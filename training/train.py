@@ -82,6 +82,7 @@ class TrainConfig(Config):
     use_points: bool = True
     hidden: int = HIDDEN  # width of every layer: a search pays for it at every state
     features: tuple[str, ...] = ()  # proposal features the scorer reads (zonegraph.sequence.features)
+    context: bool = False  # the readout also reads the max over the state's proposals' codes
     loss: str = "focal"  # focal (per proposal) or listwise (softmax over a state's proposals)
     neutral_credit: float | None = None  # listwise: None leaves neutrals out, else their target weight
     # listwise: trained checkpoints whose mean log-odds share the target (one, or an ensemble)
@@ -122,6 +123,7 @@ class TrainConfig(Config):
             use_points=self.use_points,
             hidden=self.hidden,
             features=self.features,
+            context=self.context,
         )
 
     def check(self) -> None:
@@ -251,15 +253,15 @@ def rank_places(
 def _numpy_scores(folded: FoldedScorer, graph: State, codes: np.ndarray | None, state: Any) -> np.ndarray:
     """(P,) one state's scores, in chunks of proposals of at most `RANK_ROWS` zone copies (a
     state of a 16,500-zone graph has had 16,800 proposals: 277 million copies); the state's own
-    zone codes are computed once and kept for the later chunks (`CodeMemo`)."""
+    zone codes are computed once and kept for the later chunks (`CodeMemo`), and the chunks are
+    read together (a scorer with a context reads the whole state's)."""
     p, z = state.zones.shape
     size, memo = max(1, RANK_ROWS // max(z, 1)), CodeMemo()
     at = graph.with_canvas(state.canvas)
     ops = state.ops.astype(np.float32)
     chunks = [slice(i, i + size) for i in range(0, p, size)]
-    return np.concatenate(
-        [folded.score(at, state.zones[c], ops[c], codes, state.features[c], memo) for c in chunks]
-    )
+    embedded = [folded.embed(at, state.zones[c], ops[c], codes, state.features[c], memo) for c in chunks]
+    return folded.read(np.concatenate(embedded))
 
 
 def _numpy_graph(folded: FoldedScorer, geometry: Geometry) -> tuple[State, np.ndarray | None]:
@@ -307,6 +309,7 @@ def run_name(config: TrainConfig, train_designs: int) -> str:
     """What the dashboard lists: the fusion, the objective, the data and the seed."""
     features = " +features" if config.features else ""
     width = f" hidden{config.hidden}" if config.hidden != HIDDEN else ""
+    width += " +context" if config.context else ""
     many = f"x{len(config.teacher)}" if len(config.teacher) > 1 else ""
     taught = f" +teacher{many}{config.distill:g}" if config.teacher else ""
     return f"{config.fusion} {config.loss}{features}{width}{taught} {train_designs} designs seed{config.seed}"

@@ -78,8 +78,9 @@ def _never(self, state, zones, fresh=False):
         ModelConfig(use_points=False, features=FEATURES),
         ModelConfig(use_points=True, features=("depth", "union", "step")),
         ModelConfig(use_points=True, rounds=2),
+        ModelConfig(use_points=False, features=FEATURES, context=True),
     ],
-    ids=["flags+features", "points+features", "points"],
+    ids=["flags+features", "points+features", "points", "flags+features+context"],
 )
 @pytest.mark.parametrize("path", ["within reach", "every zone"])
 def test_a_folded_scorer_scores_real_states_as_pytorch(states, config, path, monkeypatch):

@@ -490,16 +490,18 @@ def test_holdouts_drawn_with_two_seeds_are_independent_draws_of_about_their_shar
 
 
 @requires_samples
-@pytest.mark.parametrize(("use_points", "rows"), [(False, 2_000_000), (True, 40)])
+@pytest.mark.parametrize(
+    ("use_points", "rows", "context"), [(False, 2_000_000, False), (True, 40, False), (False, 40, True)]
+)
 def test_validation_ranks_with_the_numpy_fold_as_with_the_pytorch_forward(
-    labelled, tmp_path, monkeypatch, use_points, rows
+    labelled, tmp_path, monkeypatch, use_points, rows, context
 ):
     from training.train import rank_metrics, rank_places
     from zonegraph.sequence.features import FEATURES
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr("training.train.RANK_ROWS", rows)  # 40: a state's proposals a few at a time
-    train(_quick(labelled, loss="listwise", features=FEATURES, use_points=use_points))
+    train(_quick(labelled, loss="listwise", features=FEATURES, use_points=use_points, context=context))
     model = load_scorer(tmp_path / "models" / "scorer.pt")
     data = LabelDataset(labelled / "labels", labelled / "graphs", mode="rank", points_per_zone=16)
     cpu = torch.device("cpu")

@@ -89,7 +89,8 @@ class FoldedScorer:
     ``points``/``head`` encode a zone's samples (absent without the point encoder), ``zone_in``
     reads its code and four flags, each of ``rounds`` reads a zone's code beside its neighbours'
     mean, ``features`` embeds the proposal features (the model's ``columns`` of
-    `zonegraph.sequence.features.FEATURES`), ``readout`` gives the two logits.
+    `zonegraph.sequence.features.FEATURES`), ``readout`` gives the two logits (with the config's
+    ``context``, from each proposal's code beside the state's greatest).
     """
 
     config: dict[str, Any]
@@ -125,7 +126,21 @@ class FoldedScorer:
         features: np.ndarray | None = None,
         memo: CodeMemo | None = None,
     ) -> np.ndarray:
-        """P(positive) of each of P proposals of one state.
+        """P(positive) of each of P proposals of one state: `read` of their `embed`."""
+        return self.read(self.embed(state, zones, ops, geometry, features, memo))
+
+    def embed(
+        self,
+        state: State,
+        zones: np.ndarray,
+        ops: np.ndarray,
+        geometry: np.ndarray | None = None,
+        features: np.ndarray | None = None,
+        memo: CodeMemo | None = None,
+    ) -> np.ndarray:
+        """(P, H') each of P proposals of one state as the readout reads it: its pooled zone
+        codes and, with features, their embedding. Proposals embed apart from one another, so a
+        state's may be embedded in parts and read together.
 
         A proposal changes the flags of its extrusion's zones only, and a round of message passing
         carries a change one zone further, so after round r a proposal's zone codes differ from
@@ -140,7 +155,7 @@ class FoldedScorer:
 
         Shapes:
             zones: (P, Z) bool, the extrusions; ops: (P,) +1 union, -1 subtract; geometry: (Z, H)
-            from `encode_geometry`; features: (P, F) every column of FEATURES; returns (P,).
+            from `encode_geometry`; features: (P, F) every column of FEATURES; returns (P, H').
         """
         zones = zones.astype(bool)
         extrusion = np.where(zones, np.where(ops > 0, 1, 2)[:, None], 0)  # (P, Z): 0 none, 1 union, 2 cut
@@ -152,11 +167,19 @@ class FoldedScorer:
             pooled, codes = self._pool_within_reach(state, extrusion, geometry, reach, last)
             if memo is not None:
                 memo.last = codes
-        if self.columns:
-            p = len(zones)
-            taken = np.zeros((p, max(self.columns) + 1), np.float32) if features is None else features
-            pooled = np.concatenate([pooled, run(self.features, taken[:, list(self.columns)])], axis=1)
-        logits = run(self.readout, pooled)
+        if not self.columns:
+            return pooled
+        taken = np.zeros((len(zones), max(self.columns) + 1), np.float32) if features is None else features
+        return np.concatenate([pooled, run(self.features, taken[:, list(self.columns)])], axis=1)
+
+    def read(self, codes: np.ndarray) -> np.ndarray:
+        """(P,) P(positive) of a state's P proposals from their (P, H') `embed` (with a context,
+        beside the greatest of each channel over them: every proposal of the state at once)."""
+        if not len(codes):
+            return np.zeros(0, np.float32)
+        if self.config.get("context"):
+            codes = np.concatenate([codes, np.broadcast_to(codes.max(axis=0), codes.shape)], axis=1)
+        logits = run(self.readout, codes)
         return 1.0 / (1.0 + np.exp(logits[:, 0] - logits[:, 1]))
 
     def _reach(self, state: State, zones: np.ndarray, fresh: bool = False) -> list[np.ndarray] | None:

@@ -22,6 +22,12 @@ heuristic's terms, the extrusion's geometry, the step) join after the pool: stan
 BatchNorm, embedded by a small MLP and concatenated to the pooled zone code before the readout,
 in every fusion. An empty tuple is the paper's network (and every checkpoint trained before).
 
+With ``context`` the readout also reads the state's context: per channel, the greatest code
+(pooled zones and features) among the proposals scored with it. Each proposal is otherwise
+scored alone, so the network cannot tell a state's first choice from a runner-up of equal merit;
+a max over the set (a DeepSets pooling) is the cheapest layer that sees them together, and it
+changes least when the set is a subset (the search scores the heuristic's top few).
+
 Shapes follow PyG: zones of all proposals in a batch are stacked ((N, ...) with ``batch`` the
 proposal of each zone), ``edge_index`` (2, E) holds both directions of every adjacency.
 """
@@ -34,6 +40,7 @@ from typing import Any
 import torch
 from torch import Tensor, nn
 from torch_geometric.nn import MessagePassing, global_max_pool
+from torch_geometric.utils import scatter
 
 from zonegraph.configs import Config
 from zonegraph.sequence.features import FEATURES
@@ -52,6 +59,7 @@ class ModelConfig(Config):
     use_points: bool = True  # False: zones are their flags only (the geometry ablation)
     hidden: int = HIDDEN
     features: tuple[str, ...] = ()  # names of zonegraph.sequence.features.FEATURES; () the paper's
+    context: bool = False  # the readout also reads the max over the state's proposals' codes
 
     def feature_columns(self) -> list[int]:
         """Columns of the data's ``feat`` this model reads."""
@@ -147,7 +155,8 @@ class ProposalScorer(nn.Module):
             self.features_in = nn.Sequential(
                 nn.BatchNorm1d(len(self.columns)), _mlp([len(self.columns), extra, extra], last_plain=False)
             )
-        self.readout = nn.Sequential(_mlp([h + extra, h, h], last_plain=False), nn.Linear(h, 2))
+        width = (h + extra) * (2 if config.context else 1)
+        self.readout = nn.Sequential(_mlp([width, h, h], last_plain=False), nn.Linear(h, 2))
 
     def encode_geometry(self, points: Tensor) -> Tensor | None:
         """Per-graph zone codes (late and factored fusion), (Z, hidden) from (Z, 6, S) samples."""
@@ -175,10 +184,16 @@ class ProposalScorer(nn.Module):
         return self._readout(global_max_pool(x, data.proposal), data)
 
     def _readout(self, pooled: Tensor, data: Any) -> Tensor:
-        """Logits from the pooled zone codes (P, hidden) and the proposal features, when read."""
-        if not self.columns:
-            return self.readout(pooled)
-        return self.readout(torch.cat([pooled, self.features_in(data.feat[:, self.columns])], dim=1))
+        """Logits from the pooled zone codes (P, hidden), the proposal features when read, and
+        the state's context when read."""
+        code = pooled
+        if self.columns:
+            code = torch.cat([pooled, self.features_in(data.feat[:, self.columns])], dim=1)
+        if self.config.context:
+            states = int(data.state.max()) + 1 if len(data.state) else 0
+            context = scatter(code, data.state, dim=0, dim_size=states, reduce="max")
+            code = torch.cat([code, context[data.state]], dim=1)
+        return self.readout(code)
 
     def _factored(self, data: Any, geometry: Tensor | None) -> Tensor:
         state_flags = torch.zeros(data.points.shape[0], 2, device=data.x.device)
