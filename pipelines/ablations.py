@@ -11,7 +11,8 @@ A variant is a ``+``-joined list of changes to the ``train`` section of the para
 ``focal`` / ``listwise`` (the objective), ``features`` / ``no_features`` (every proposal feature of
 `PROPOSAL_FEATURES`, or none), ``state_features`` (those and the `STATE_FEATURES`), ``late`` /
 ``early`` (the fusion),
-``points`` / ``no_points`` (the zones' point geometry), ``roundsN``, ``hiddenN`` (the width of
+``points`` / ``no_points`` (the zones' point geometry), ``context`` (the readout reads the state's
+proposals together), ``roundsN``, ``hiddenN`` (the width of
 every layer) and ``teacher`` (the listwise target shared with ``--teacher``'s scores: a student
 distilled from a trained checkpoint); e.g. ``listwise+features+early`` or
 ``listwise+features+no_points+hidden48+teacher``. Without ``--variants`` the runner trains the
@@ -53,6 +54,7 @@ CHANGES: dict[str, dict[str, Any]] = {  # a variant's tokens, as overrides of th
     "early": {"fusion": "early"},
     "points": {"use_points": True},
     "no_points": {"use_points": False},
+    "context": {"context": True},
 }
 
 
@@ -123,8 +125,10 @@ def train_variant(name: str, config: TrainConfig, out: Path) -> Path:
 
 
 def same_settings(stamp: str, wanted: str) -> bool:
-    """Two variant configs alike but for their folder: a copied or moved ablation reuses its runs."""
-    first, second = json.loads(stamp), json.loads(wanted)
+    """Two variant configs alike but for their folder: a copied or moved ablation reuses its runs.
+    A setting added since the stamp was written reads as its default, which that run trained with."""
+    defaults = json.loads(json.dumps(asdict(TrainConfig())))
+    first, second = {**defaults, **json.loads(stamp)}, json.loads(wanted)
     first.pop("out_dir", None)
     second.pop("out_dir", None)
     return bool(first == second)
@@ -137,7 +141,7 @@ def describe(config: TrainConfig) -> str:
     taught = f", {config.distill:g} taught by {names}" if config.teacher else ""
     return (
         f"{config.loss}, {features}, {config.fusion} fusion, {points}, {config.rounds} rounds, "
-        f"hidden {config.hidden}{taught}"
+        f"hidden {config.hidden}{', state context' if config.context else ''}{taught}"
     )
 
 

@@ -267,6 +267,11 @@ def test_an_ablation_variant_trains_once_then_is_reused(labelled, tmp_path, monk
         "rounds0", replace(configs["rounds0"], lr=configs["rounds0"].lr * 10), tmp_path / "out"
     )
     assert other.stat().st_mtime_ns != written  # another config: trained again
+    stamp = path.parent / "config.json"
+    older = {k: v for k, v in json.loads(stamp.read_text()).items() if k != "context"}
+    stamp.write_text(json.dumps({**older, "lr": configs["rounds0"].lr}))  # before `context` existed
+    written = path.stat().st_mtime_ns
+    assert train_variant("rounds0", configs["rounds0"], tmp_path / "out").stat().st_mtime_ns == written
 
 
 def test_an_ablation_variant_is_the_base_with_its_changes_each_alone_and_combined():
@@ -276,6 +281,7 @@ def test_an_ablation_variant_is_the_base_with_its_changes_each_alone_and_combine
     combined = variant(base, "listwise+features+early+no_points+rounds1")
     assert (combined.loss, combined.features, combined.fusion) == ("listwise", PROPOSAL_FEATURES, "early")
     assert variant(base, "state_features").features == FEATURES
+    assert variant(base, "context").model.context and not base.model.context
     assert (combined.use_points, combined.rounds) == (False, 1)
     assert variant(base, "base") == base and variant(combined, "focal").neutral_credit is None
     specs = default_specs(base, [1, 3])
