@@ -8,6 +8,11 @@ with the proposal counts; beside it every table carries the normalised rank (ran
 could reach on these steps) and the top-1 / top-5 hit rates (``docs/evaluation.md``). Steps with
 a single proposal rank nothing: they are left out of every mean and counted (``single``).
 
+Each step also carries its ``kind`` (`STEP_KINDS`): whether the GT completes the target, or
+another proposal does and the GT does not (there the designer took a longer way than the state
+offers, and a guide that puts the finishing proposal first is right for reconstruction while
+the GT's rank counts it wrong), or none does. `by_kind` breaks every guide's rank down by it.
+
 The states come from the ``labels`` stage's Parquet shards (rank-only labels suffice: every
 proposal, the GT flagged), the zone graphs from the ``zonegraphs`` stage, and every guide is
 reached through ``make_ranker``, so a network is scored exactly as the search would call it
@@ -57,6 +62,19 @@ class RankState:
     canvas: np.ndarray
     proposals: list[Proposal]
     is_gt: np.ndarray
+    target: np.ndarray  # (Z,) bool, the zones inside the design
+
+    @property
+    def kind(self) -> str:
+        """Which proposals complete the target (`STEP_KINDS`)."""
+        completes = np.array([np.array_equal(p.apply(self.canvas), self.target) for p in self.proposals])
+        if completes[self.is_gt].any():
+            return "gt_completes"
+        return "other_completes" if completes.any() else "none_completes"
+
+
+# the GT completes the target; another proposal does and the GT does not; no proposal does
+STEP_KINDS = ("gt_completes", "other_completes", "none_completes")
 
 
 def _mask(ids: Sequence[int], n: int) -> np.ndarray:
@@ -106,6 +124,7 @@ def rank_states(
                     _mask(canvas_of[(design_id, step)], graph.n_zones),
                     [_proposal(r, graph.n_zones) for r in group.itertuples()],
                     is_gt,
+                    graph.zone_inside.astype(bool),
                 )
             )
         if states:
@@ -119,7 +138,7 @@ def _proposal(row: Any, n_zones: int) -> Proposal:
 
 
 METRICS = ("rank", "normalised", "floor", "top1", "top5")  # the per-step columns of guide_ranks
-COLUMNS = ["guide", "design_id", "step", "proposals", "above", "ties", *METRICS]
+COLUMNS = ["guide", "design_id", "step", "kind", "proposals", "above", "ties", *METRICS]
 
 
 def place_row(guide: str, state: RankState, place: GTPlace) -> dict[str, Any]:
@@ -128,6 +147,7 @@ def place_row(guide: str, state: RankState, place: GTPlace) -> dict[str, Any]:
         "guide": guide,
         "design_id": state.design_id,
         "step": state.step,
+        "kind": state.kind,
         "proposals": place.proposals,
         "above": place.above,
         "ties": place.ties,
@@ -300,6 +320,48 @@ def by_folder(
     return pd.DataFrame(rows)
 
 
+def by_kind(ranks: pd.DataFrame, level: float = 0.9, seed: int = 0) -> pd.DataFrame:
+    """Per kind of step (`STEP_KINDS`) and guide: ranked steps, the guide's share of its own
+    normalised-rank sum there, the mean normalised rank and top-1, and its normalised rank over
+    the heuristic's with the paired interval (`ratios` within the kind). Empty for ranks written
+    before steps had a kind."""
+    if "kind" not in ranks:
+        return pd.DataFrame()
+    steps = ranked(ranks)
+    totals = steps.groupby("guide", sort=False)["normalised"].sum()
+    rows = []
+    for kind in STEP_KINDS:
+        group = steps[steps["kind"] == kind]
+        paired = ratios(group, level=level, seed=seed).set_index("guide")
+        for guide, at in group.groupby("guide", sort=False):
+            total = float(totals[guide])
+            row = {
+                "kind": kind,
+                "guide": guide,
+                "steps": len(at),
+                "share": float(at["normalised"].sum()) / total if total else float("nan"),
+                "normalised": float(at["normalised"].mean()),
+                "top1": float(at["top1"].mean()),
+            }
+            for key, field in (("vs_heuristic", "ratio"), ("ci_low", "ci_low"), ("ci_high", "ci_high")):
+                row[key] = float(paired.at[guide, field]) if guide in paired.index else float("nan")
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def kind_markdown(table: pd.DataFrame) -> str:
+    """`by_kind` as a Markdown table."""
+    lines = [
+        "| step | guide | steps | share of its sum | normalised rank | top-1 | / heuristic's (90% CI) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in table.itertuples():
+        ratio = "" if np.isnan(r.vs_heuristic) else f"{r.vs_heuristic:.3f} ({r.ci_low:.3f} - {r.ci_high:.3f})"
+        cells = f"{r.steps} | {r.share:.3f} | {r.normalised:.4f} | {r.top1:.3f}"
+        lines.append(f"| {r.kind} | {r.guide} | {cells} | {ratio} |")
+    return "\n".join(lines) + "\n"
+
+
 def folder_markdown(table: pd.DataFrame) -> str:
     """`by_folder` as a Markdown table."""
     lines = [
@@ -453,6 +515,10 @@ def main(argv: list[str] | None = None) -> None:
         per = by_folder(ranks, folders, seed=args.seed)
         records["by_folder"] = per.to_dict(orient="records")
         text += "\nBy timeline folder (steps with more than one proposal):\n\n" + folder_markdown(per)
+    kinds = by_kind(ranks, seed=args.seed)
+    if len(kinds):
+        records["by_kind"] = kinds.to_dict(orient="records")
+        text += "\nBy kind of step (which proposals complete the target):\n\n" + kind_markdown(kinds)
     (args.out / "rank.json").write_text(json.dumps(records, indent=2))
     (args.out / "rank.md").write_text(text)
     plot_ranks(table, args.out / "rank.png")

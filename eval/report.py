@@ -47,8 +47,10 @@ from eval.heldout import (
 )
 from eval.programs import program_measures
 from eval.rank import (
+    by_kind,
     design_folders,
     guide_ranks,
+    kind_markdown,
     make_guides,
     markdown,
     plot_ranks,
@@ -182,6 +184,9 @@ def rank_section(args: argparse.Namespace, guides: list[Guide], out: Path) -> tu
         for metric, name in (("rank", "rank / P"), ("normalised", "normalised rank"), ("top1", "top-1")):
             per = steps.groupby(["folder", "guide"], sort=True)[metric].mean().unstack("guide")
             text += f"\nBy timeline folder (mean {name}):\n\n" + _frame_md(per[table["guide"]]) + "\n"
+    kinds = by_kind(ranks, seed=args.seed)
+    if len(kinds):
+        text += "\nBy kind of step (which proposals complete the target):\n\n" + kind_markdown(kinds)
     return table.assign(**_ratio_columns(table, ratio)), text
 
 

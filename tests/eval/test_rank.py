@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -44,6 +46,23 @@ def test_states_rebuild_the_proposals_the_heuristic_ranks(labelled):
         gt = state.proposals[int(np.flatnonzero(state.is_gt)[0])]
         assert not np.array_equal(gt.apply(state.canvas), state.canvas)  # the GT changes the canvas
     assert list(rank_states(labels, graphs, "train")) == []  # a split filter, not a label filter
+
+
+@requires_samples
+def test_a_step_knows_whether_its_gt_or_another_proposal_completes_the_target(labelled):
+    labels, graphs, graph = labelled
+    [(_, states)] = list(rank_states(labels, graphs, "test"))
+    last = states[-1]
+    gt = last.proposals[int(np.flatnonzero(last.is_gt)[0])]
+    assert np.array_equal(gt.apply(last.canvas), graph.zone_inside) and last.kind == "gt_completes"
+    first = states[0]  # Couch takes several steps: its first completes nothing
+    assert len(states) > 1 and first.kind == "none_completes"
+    finishing = [p for p in last.proposals if np.array_equal(p.apply(last.canvas), graph.zone_inside)]
+    others = [p for p in last.proposals if not np.array_equal(p.apply(last.canvas), graph.zone_inside)]
+    assert others, "a completing step with nothing else to rank"
+    is_gt = np.arange(len(finishing) + 1) == len(finishing)  # the GT a proposal that does not finish
+    swapped = replace(last, proposals=[*finishing, others[0]], is_gt=is_gt)
+    assert swapped.kind == "other_completes"
 
 
 @requires_samples
@@ -127,6 +146,31 @@ def test_ranks_by_folder_pair_each_folders_designs_alone():
     text = folder_markdown(by_folder(ranks, {"a": "01", "b": "02", "c": "02"}))
     assert "| 02 | net | 2 | 2 | 0.1500 | 0.000 | 1.000 | 0.500 (" in text
     assert "| 01 | net | 1 | 1 | 0.0000 |" in text
+
+
+def test_ranks_by_kind_of_step_split_each_guides_sum_and_pair_within_a_kind():
+    from eval.rank import by_kind, kind_markdown, ratios
+
+    rows = []
+    for design, kind, heuristic, net in [
+        ("a", "gt_completes", 0.1, 0.0),
+        ("b", "other_completes", 0.6, 0.5),
+        ("c", "none_completes", 0.4, 0.1),
+        ("d", "none_completes", 0.2, 0.1),
+    ]:
+        for guide, value in (("heuristic", heuristic), ("net", net)):
+            at = {"guide": guide, "design_id": design, "kind": kind}
+            rows.append({**at, "step": 0, "proposals": 5, "normalised": value})
+            rows.append({**at, "step": 1, "proposals": 1, "normalised": 0.0})
+    ranks = pd.DataFrame(rows).assign(top1=lambda f: f["normalised"] == 0, top5=True)
+    table = by_kind(ranks, seed=2).set_index(["kind", "guide"])
+    assert table.loc[("other_completes", "net"), "share"] == pytest.approx(0.5 / 0.7)
+    assert table.loc[("none_completes", "net"), "steps"] == 2  # single-proposal steps left out
+    assert table.groupby("guide")["share"].sum().tolist() == pytest.approx([1.0, 1.0])
+    expected = ratios(ranks[ranks["kind"] == "none_completes"], seed=2).set_index("guide").loc["net"]
+    assert table.loc[("none_completes", "net"), "vs_heuristic"] == pytest.approx(1 / 3) == expected["ratio"]
+    assert "| other_completes | net | 1 | 0.714 | 0.5000 | 0.000 | 0.833 (" in kind_markdown(by_kind(ranks))
+    assert by_kind(ranks.drop(columns="kind")).empty  # ranks written before steps had a kind
 
 
 def test_an_earlier_runs_ranks_are_summarised_again_without_the_listed_designs(tmp_path):
