@@ -12,7 +12,14 @@ import torch
 from zonegraph.data.design import load_design
 from zonegraph.data.replay import replay
 from zonegraph.network.checkpoint import SHIPPED, fold, fold_checkpoint, read_checkpoint
-from zonegraph.network.folded import SHIPPED_FOLDED, CodeMemo, FoldedScorer, State, _max_elsewhere
+from zonegraph.network.folded import (
+    SHIPPED_FOLDED,
+    CodeMemo,
+    FoldedScorer,
+    State,
+    _max_elsewhere,
+    zone_samples,
+)
 from zonegraph.network.model import ModelConfig, ProposalScorer
 from zonegraph.network.ranker import NetworkRanker, NumpyScorer, open_scorer
 from zonegraph.network.scoring import TorchScorer
@@ -391,3 +398,52 @@ def test_the_greatest_code_a_proposal_left_untouched_is_found_among_each_channel
     expected = np.stack([codes[~r].max(axis=0) if (~r).any() else np.full(6, -np.inf) for r in reached])
     for top in (1, 16, 40):
         np.testing.assert_array_equal(_max_elsewhere(codes, reached, top), expected)
+
+
+def _seeded(config: ModelConfig, seed: int) -> FoldedScorer:
+    model, generator = _trained_like(config), torch.Generator().manual_seed(seed)
+    with torch.no_grad():
+        for parameter in model.parameters():  # members of one recipe, other seeds
+            parameter.add_(0.2 * torch.randn(parameter.shape, generator=generator))
+    return fold(model)
+
+
+@requires_samples
+@pytest.mark.parametrize(
+    "config",
+    [
+        ModelConfig(use_points=False, features=FEATURES, hidden=16),
+        ModelConfig(use_points=True, features=("depth", "union"), hidden=16, context=True),
+        ModelConfig(use_points=True, rounds=2, hidden=16),
+    ],
+    ids=["flags+features", "points+features+context", "points"],
+)
+def test_an_ensemble_side_by_side_scores_the_mean_log_odds_of_its_members(states, config):
+    from zonegraph.network.ensemble import side_by_side
+
+    members = [_seeded(config, seed) for seed in range(3)]
+    ensemble = side_by_side(members)
+    assert ensemble.config["hidden"] == 48 and ensemble.config["members"] == 3
+    for graph, canvas, proposals in states:
+        zones = np.stack([p.zones for p in proposals]).astype(bool)
+        ops = np.array([1 if p.op is Op.UNION else -1 for p in proposals], np.float32)
+        features = proposal_features(graph, canvas, proposals, 1)
+        state = State.of(graph.zone_inside, canvas, graph.edges.astype(np.int64))
+        samples = zone_samples(graph, 16) if config.use_points else None
+        geometry = [None if samples is None else m.encode_geometry(samples) for m in [*members, ensemble]]
+        log_odds = [
+            m.log_odds(m.embed(state, zones, ops, codes, features))
+            for m, codes in zip([*members, ensemble], geometry, strict=True)
+        ]
+        assert np.abs(np.mean(log_odds[:3], axis=0) - log_odds[3]).max() < 1e-4 * np.abs(log_odds[3]).max()
+        assert np.abs(log_odds[0] - log_odds[1]).max() > 0.01  # the members disagree: the mean is tested
+
+
+def test_members_of_different_architectures_make_no_ensemble():
+    from zonegraph.network.ensemble import side_by_side
+
+    flags = _seeded(ModelConfig(use_points=False, hidden=16), 0)
+    with pytest.raises(ValueError, match="use_points"):
+        side_by_side([flags, _seeded(ModelConfig(use_points=True, hidden=16), 1)])
+    with pytest.raises(ValueError, match="two members"):
+        side_by_side([flags])

@@ -173,14 +173,18 @@ class FoldedScorer:
         return np.concatenate([pooled, run(self.features, taken[:, list(self.columns)])], axis=1)
 
     def read(self, codes: np.ndarray) -> np.ndarray:
-        """(P,) P(positive) of a state's P proposals from their (P, H') `embed` (with a context,
-        beside the greatest of each channel over them: every proposal of the state at once)."""
+        """(P,) P(positive) of a state's P proposals from their (P, H') `embed`."""
+        return 1.0 / (1.0 + np.exp(-self.log_odds(codes)))
+
+    def log_odds(self, codes: np.ndarray) -> np.ndarray:
+        """(P,) the log-odds of a state's P proposals from their (P, H') `embed` (with a
+        context, beside the greatest of each channel over them: every proposal of the state)."""
         if not len(codes):
             return np.zeros(0, np.float32)
         if self.config.get("context"):
             codes = np.concatenate([codes, np.broadcast_to(codes.max(axis=0), codes.shape)], axis=1)
         logits = run(self.readout, codes)
-        return 1.0 / (1.0 + np.exp(logits[:, 0] - logits[:, 1]))
+        return logits[:, 1] - logits[:, 0]
 
     def _reach(self, state: State, zones: np.ndarray, fresh: bool = False) -> list[np.ndarray] | None:
         """(P, Z) per layer: the zones whose codes each proposal changes after ``zone_in`` and
