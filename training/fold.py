@@ -34,6 +34,7 @@ def main(argv: list[str] | None = None) -> None:
         folded = members[0] if len(members) == 1 else side_by_side(members)
     except ValueError as exc:
         raise SystemExit(f"training.fold: {exc}") from None
+    out.parent.mkdir(parents=True, exist_ok=True)
     folded.save(out)
     names = " + ".join(str(path) for path in args.checkpoint)
     print(f"{names} -> {out} ({out.stat().st_size / 1e6:.2f} MB)")

@@ -447,3 +447,26 @@ def test_members_of_different_architectures_make_no_ensemble():
         side_by_side([flags, _seeded(ModelConfig(use_points=True, hidden=16), 1)])
     with pytest.raises(ValueError, match="two members"):
         side_by_side([flags])
+
+
+def test_fold_writes_one_checkpoint_or_several_as_one_ensemble(tmp_path, capsys):
+    from training.fold import main
+
+    config = ModelConfig(use_points=False, features=FEATURES, hidden=16)
+    paths = []
+    for seed in range(2):
+        model, generator = _trained_like(config), torch.Generator().manual_seed(seed)
+        with torch.no_grad():
+            for parameter in model.parameters():
+                parameter.add_(0.2 * torch.randn(parameter.shape, generator=generator))
+        paths.append(tmp_path / f"seed{seed}" / "scorer.pt")
+        paths[-1].parent.mkdir()
+        torch.save({"model": config.__dict__, "state_dict": model.state_dict()}, paths[-1])
+    main([str(paths[0])])
+    assert FoldedScorer.load(paths[0].with_suffix(".npz")).config["hidden"] == 16
+    with pytest.raises(SystemExit, match="needs --out"):
+        main([str(p) for p in paths])
+    main([*map(str, paths), "--out", str(tmp_path / "ensemble" / "scorer.npz")])
+    ensemble = FoldedScorer.load(tmp_path / "ensemble" / "scorer.npz")
+    assert (ensemble.config["hidden"], ensemble.config["members"]) == (32, 2)
+    assert "seed0/scorer.pt + " in capsys.readouterr().out
