@@ -325,7 +325,8 @@ RANK_METRICS = ("rank", "floor", "normalised", "top1", "top5")
 
 def rank_figure(results: dict) -> dict:
     """The GT rank per guide (``eval.rank``'s ``rank.json``): designs, ranked and single steps,
-    every scale with its 90% interval, and each guide's normalised rank over the heuristic's."""
+    every scale with its 90% interval, and each guide's normalised rank over the heuristic's;
+    by timeline folder and by kind of step where the results have them."""
     guides = {}
     for r in results["guides"]:
         entry = {"designs": int(r["designs"]), "steps": int(r["steps"]), "single": int(r["single"])}
@@ -358,6 +359,20 @@ def rank_figure(results: dict) -> dict:
                 "ci": [_rounded(r["ci_low"], 3), _rounded(r["ci_high"], 3)],
             }
             for r in results["by_folder"]
+        ]
+    if results.get("by_kind"):
+        figure["by_kind"] = [
+            {
+                "kind": str(r["kind"]),
+                "guide": str(r["guide"]),
+                "steps": int(r["steps"]),
+                "share": _rounded(r["share"], 3),
+                "normalised": _rounded(r["normalised"], 4),
+                "top1": _rounded(r["top1"], 3),
+                "vs_heuristic": _rounded(r["vs_heuristic"], 3),
+                "ci": [_rounded(r["ci_low"], 3), _rounded(r["ci_high"], 3)],
+            }
+            for r in results["by_kind"]
         ]
     return figure
 

@@ -377,16 +377,38 @@ def rank(records: list[dict]) -> str:
             "| steps | normalised rank | top-1 | top-5 | / heuristic's (90% CI) |\n"
             "|---|---|---|---|---|---|---|---|---|\n" + "\n".join(row for rows in folders for row in rows)
         )
+    kinds = [_kind_rows(r) for r in records if r["figure"].get("by_kind")]
+    if kinds:
+        text += (
+            "\n\nBy kind of step (gt_completes: the GT completes the target; other_completes: another "
+            "proposal does and the GT does not; none_completes: none does):\n\n| run | step | guide | steps "
+            "| share of its sum | normalised rank | top-1 | / heuristic's (90% CI) |\n"
+            "|---|---|---|---|---|---|---|---|\n" + "\n".join(row for rows in kinds for row in rows)
+        )
     return text + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def _ratio_cell(value: float | None, low: float | None, high: float | None) -> str:
+    """A ratio with its interval, or "-" where it has none (the heuristic itself, or a base that
+    ranks every GT first)."""
+    if value is None or not math.isfinite(value):
+        return "-"
+    return f"{value:.3f}" + ("" if low is None else f" ({low:.3f} - {high:.3f})")
+
+
+def _kind_rows(record: dict) -> list[str]:
+    rows = []
+    for k in record["figure"]["by_kind"]:
+        cells = [record["name"], k["kind"], k["guide"], str(k["steps"]), f"{k['share']:.3f}"]
+        cells += [f"{k['normalised']:.4f}", f"{k['top1']:.3f}", _ratio_cell(k["vs_heuristic"], *k["ci"])]
+        rows.append("| " + " | ".join(cells) + " |")
+    return rows
 
 
 def _folder_rows(record: dict) -> list[str]:
     rows = []
     for f in record["figure"]["by_folder"]:
-        value, (low, high) = f["vs_heuristic"], f["ci"]
-        ratio = "-"  # the heuristic ranks every GT of the folder first
-        if value is not None and math.isfinite(value):
-            ratio = f"{value:.3f}" + ("" if low is None else f" ({low:.3f} - {high:.3f})")
+        ratio = _ratio_cell(f["vs_heuristic"], *f["ci"])
         cells = [record["name"], f["folder"], f["guide"], str(f["designs"]), str(f["steps"])]
         cells += [f"{f['normalised']:.4f}", f"{f['top1']:.3f}", f"{f['top5']:.3f}", ratio]
         rows.append("| " + " | ".join(cells) + " |")

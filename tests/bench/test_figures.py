@@ -351,6 +351,15 @@ def test_the_rank_figure_keeps_every_scale_with_its_interval_and_the_ratio():
     assert "| run | 08_21plus | net | 3 | 9 | 0.0355 | 0.700 | 1.000 | 0.258 (0.100 - 0.450) |" in table
     assert "| run | 01_2ops | net | 3 | 9 | 0.0355 | 0.700 | 1.000 | - |" in table
     assert "| run | 01_2ops | random | 3 | 9 | 0.0355 | 0.700 | 1.000 | - |" in table
+    assert "By kind of step" not in table
+    kind = {"kind": "other_completes", "guide": "net", "steps": 141, "share": 0.3431, "normalised": 0.36279}
+    kind |= {"top1": 0.004, "vs_heuristic": 0.9046, "ci_low": 0.851, "ci_high": 0.953}
+    itself = {**kind, "guide": "heuristic", "vs_heuristic": float("nan"), "ci_low": float("nan")}
+    figure = rank_figure(results | {"by_kind": [itself, kind]})
+    assert figure["by_kind"][1]["share"] == 0.343 and figure["by_kind"][0]["vs_heuristic"] is None
+    table = _hook().rank([record | {"figure": figure}])
+    assert "| run | other_completes | net | 141 | 0.343 | 0.3628 | 0.004 | 0.905 (0.851 - 0.953) |" in table
+    assert "| run | other_completes | heuristic | 141 | 0.343 | 0.3628 | 0.004 | - |" in table
 
 
 def test_the_heavy_figure_shows_each_stage_before_and_after_and_what_ran_out_of_time():
