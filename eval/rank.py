@@ -314,9 +314,7 @@ def by_folder(
                 "steps": len(at),
                 **{m: float(at[m].mean()) for m in ("normalised", "top1", "top5")},
             }
-            for key, field in (("vs_heuristic", "ratio"), ("ci_low", "ci_low"), ("ci_high", "ci_high")):
-                row[key] = float(paired.at[guide, field]) if guide in paired.index else float("nan")
-            rows.append(row)
+            rows.append(row | _paired(paired, guide))
     return pd.DataFrame(rows)
 
 
@@ -343,10 +341,22 @@ def by_kind(ranks: pd.DataFrame, level: float = 0.9, seed: int = 0) -> pd.DataFr
                 "normalised": float(at["normalised"].mean()),
                 "top1": float(at["top1"].mean()),
             }
-            for key, field in (("vs_heuristic", "ratio"), ("ci_low", "ci_low"), ("ci_high", "ci_high")):
-                row[key] = float(paired.at[guide, field]) if guide in paired.index else float("nan")
-            rows.append(row)
+            rows.append(row | _paired(paired, guide))
     return pd.DataFrame(rows)
+
+
+def _paired(paired: pd.DataFrame, guide: str) -> dict[str, float]:
+    """A guide's ratio to the heuristic and its interval from `ratios` by guide (NaN for the
+    heuristic itself, and where the heuristic ranks every GT first)."""
+    fields = (("vs_heuristic", "ratio"), ("ci_low", "ci_low"), ("ci_high", "ci_high"))
+    return {key: float(paired.at[guide, f]) if guide in paired.index else float("nan") for key, f in fields}
+
+
+def _ratio_text(row: Any) -> str:
+    """A table row's ratio to the heuristic with its interval, empty where it has none."""
+    if np.isnan(row.vs_heuristic):
+        return ""
+    return f"{row.vs_heuristic:.3f} ({row.ci_low:.3f} - {row.ci_high:.3f})"
 
 
 def kind_markdown(table: pd.DataFrame) -> str:
@@ -356,7 +366,7 @@ def kind_markdown(table: pd.DataFrame) -> str:
         "|---|---|---|---|---|---|---|",
     ]
     for r in table.itertuples():
-        ratio = "" if np.isnan(r.vs_heuristic) else f"{r.vs_heuristic:.3f} ({r.ci_low:.3f} - {r.ci_high:.3f})"
+        ratio = _ratio_text(r)
         cells = f"{r.steps} | {r.share:.3f} | {r.normalised:.4f} | {r.top1:.3f}"
         lines.append(f"| {r.kind} | {r.guide} | {cells} | {ratio} |")
     return "\n".join(lines) + "\n"
@@ -369,7 +379,7 @@ def folder_markdown(table: pd.DataFrame) -> str:
         "|---|---|---|---|---|---|---|---|",
     ]
     for r in table.itertuples():
-        ratio = "" if np.isnan(r.vs_heuristic) else f"{r.vs_heuristic:.3f} ({r.ci_low:.3f} - {r.ci_high:.3f})"
+        ratio = _ratio_text(r)
         lines.append(
             f"| {r.folder} | {r.guide} | {r.designs} | {r.steps} | {r.normalised:.4f} | {r.top1:.3f} | "
             f"{r.top5:.3f} | {ratio} |"
