@@ -92,6 +92,7 @@ def _never(self, state, zones, fresh=False):
 @pytest.mark.parametrize("path", ["within reach", "every zone"])
 def test_a_folded_scorer_scores_real_states_as_pytorch(states, config, path, monkeypatch):
     monkeypatch.setattr(FoldedScorer, "_reach", _forced_within_reach if path == "within reach" else _never)
+    monkeypatch.setattr("zonegraph.network.scoring.MAX_NODES", 100)  # PyTorch embeds in chunks, reads whole
     model = _trained_like(config)
     checkpoint = {
         "model": config.__dict__,

@@ -166,10 +166,16 @@ class ProposalScorer(nn.Module):
 
     def forward(self, data: Any, geometry: Tensor | None = None) -> Tensor:
         """Logits (P, 2) for the P proposals of a batch; ``geometry``: codes already encoded."""
+        return self.read(self.embed(data, geometry), data.state if self.config.context else None)
+
+    def embed(self, data: Any, geometry: Tensor | None = None) -> Tensor:
+        """(P, H') each proposal as the readout reads it: its pooled zone codes and, with
+        features, their embedding. Proposals embed apart from one another, so a state's may be
+        embedded in chunks and read together."""
         if self.config.fusion != "early" and geometry is None:
             geometry = self.encode_geometry(data.points)
         if self.config.fusion == "factored":
-            return self._factored(data, geometry)
+            return self._features(self._factored(data, geometry), data)
         if self.config.fusion == "early":
             if self.config.use_points:
                 channels = data.x[:, :, None].expand(-1, -1, data.points.shape[2])
@@ -181,21 +187,26 @@ class ProposalScorer(nn.Module):
             x = self.zone_in(torch.cat(parts, dim=1))
         for layer in self.rounds:
             x = layer(x, data.edge_index)
-        return self._readout(global_max_pool(x, data.proposal), data)
+        return self._features(global_max_pool(x, data.proposal), data)
 
-    def _readout(self, pooled: Tensor, data: Any) -> Tensor:
-        """Logits from the pooled zone codes (P, hidden), the proposal features when read, and
-        the state's context when read."""
-        code = pooled
-        if self.columns:
-            code = torch.cat([pooled, self.features_in(data.feat[:, self.columns])], dim=1)
+    def _features(self, pooled: Tensor, data: Any) -> Tensor:
+        """The pooled zone codes (P, hidden) beside the proposal features' embedding, when read."""
+        if not self.columns:
+            return pooled
+        return torch.cat([pooled, self.features_in(data.feat[:, self.columns])], dim=1)
+
+    def read(self, code: Tensor, state: Tensor | None = None) -> Tensor:
+        """Logits (P, 2) from the proposals' `embed`; with a context, each beside the greatest
+        code of its state's proposals (``state`` (P,), the state of each: required then)."""
         if self.config.context:
-            states = int(data.state.max()) + 1 if len(data.state) else 0
-            context = scatter(code, data.state, dim=0, dim_size=states, reduce="max")
-            code = torch.cat([code, context[data.state]], dim=1)
+            assert state is not None, "a scorer with a context reads each proposal's state"
+            states = int(state.max()) + 1 if len(state) else 0
+            context = scatter(code, state, dim=0, dim_size=states, reduce="max")
+            code = torch.cat([code, context[state]], dim=1)
         return self.readout(code)
 
     def _factored(self, data: Any, geometry: Tensor | None) -> Tensor:
+        """(P, hidden) the pooled zone codes of factored fusion."""
         state_flags = torch.zeros(data.points.shape[0], 2, device=data.x.device)
         state_flags[data.zone_of] = data.x[:, :2]  # the same in every copy of a state's zone
         x = self.zone_in(state_flags if geometry is None else torch.cat([geometry, state_flags], dim=1))
@@ -204,7 +215,7 @@ class ProposalScorer(nn.Module):
         kinds = torch.eye(3, device=x.device)
         codes = torch.stack([self.extrusion(torch.cat([x, k.expand(len(x), 3)], dim=1)) for k in kinds])
         kind = (data.x[:, 2] * torch.where(data.x[:, 3] < 0, 2.0, 1.0)).long()  # 0 out, 1 union, 2 subtract
-        return self._readout(global_max_pool(codes[kind, data.zone_of], data.proposal), data)
+        return global_max_pool(codes[kind, data.zone_of], data.proposal)
 
     @torch.no_grad()
     def score(self, data: Any, geometry: Tensor | None = None) -> Tensor:

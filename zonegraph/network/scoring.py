@@ -1,9 +1,10 @@
 """Scoring one state's proposals, in chunks that fit in memory.
 
-In eval mode a proposal's score does not depend on the others scored with it, so a state with
-hundreds of proposals over hundreds of zones is scored in chunks of proposals: early fusion runs
-a PointNet over every sample of every zone of every proposal, and one pass over 200 proposals of
-a 500-zone graph would need about 17 GB.
+In eval mode a proposal's code does not depend on the others embedded with it, so a state with
+hundreds of proposals over hundreds of zones is embedded in chunks of proposals (early fusion
+runs a PointNet over every sample of every zone of every proposal, and one pass over 200
+proposals of a 500-zone graph would need about 17 GB), and the readout then reads the whole
+state at once (a scorer with a context reads each proposal beside its state's others).
 """
 
 from __future__ import annotations
@@ -50,14 +51,17 @@ def score_state(
     """
     if model.training:  # eval() walks every module: 10% of a search's scoring when called per state
         model.eval()
-    size, scores = chunk_size(model, geometry), []
+    size, embedded = chunk_size(model, geometry), []
     for start in range(0, len(zones), size):
         chunk = slice(start, start + size)
         feats = None if features is None else features[chunk]
         data = state_data(geometry, canvas, zones[chunk], ops[chunk], feats)
-        logits = model(Batch.from_data_list([data]).to(device), geometry=codes)
-        scores.append(logits.softmax(dim=1)[:, 1].cpu())
-    return torch.cat(scores).numpy() if scores else np.zeros(0)
+        embedded.append(model.embed(Batch.from_data_list([data]).to(device), geometry=codes))
+    if not embedded:
+        return np.zeros(0)
+    code = torch.cat(embedded)
+    logits = model.read(code, torch.zeros(len(code), dtype=torch.long, device=code.device))
+    return logits.softmax(dim=1)[:, 1].cpu().numpy()
 
 
 class TorchScorer:
