@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -64,9 +65,9 @@ class RankState:
     is_gt: np.ndarray
     target: np.ndarray  # (Z,) bool, the zones inside the design
 
-    @property
+    @cached_property
     def kind(self) -> str:
-        """Which proposals complete the target (`STEP_KINDS`)."""
+        """Which proposals complete the target (`STEP_KINDS`), once per state for every guide."""
         completes = np.array([np.array_equal(p.apply(self.canvas), self.target) for p in self.proposals])
         if completes[self.is_gt].any():
             return "gt_completes"

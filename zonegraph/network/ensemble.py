@@ -6,7 +6,9 @@ mean per channel, so K members of one architecture are one network K times as wi
 that reads the members' shared input (the zone flags, the proposal features, the point
 samples) stacks their weights side by side, a layer that reads their own codes is
 block-diagonal, and the last layer averages their logits. The guide, the reach bookkeeping and
-the `.npz` format stay as they are; a search pays the wider layers and no per-member overhead.
+the `.npz` format stay as they are. The block-diagonal products are dense, zeros included, so a
+scored state costs more than the members' sum (docs/results/network.md: two members 2 - 2.5
+times one, four 5 - 6 times).
 
 Members must share the fusion, rounds, points, features and context (students of one recipe,
 trained with different seeds); their widths may differ.

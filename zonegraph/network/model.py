@@ -26,7 +26,8 @@ With ``context`` the readout also reads the state's context: per channel, the gr
 (pooled zones and features) among the proposals scored with it. Each proposal is otherwise
 scored alone, so the network cannot tell a state's first choice from a runner-up of equal merit;
 a max over the set (a DeepSets pooling) is the cheapest layer that sees them together, and it
-changes least when the set is a subset (the search scores the heuristic's top few).
+is unchanged by leaving out proposals that hold no channel's greatest value (the search scores
+the heuristic's top few only).
 
 Shapes follow PyG: zones of all proposals in a batch are stacked ((N, ...) with ``batch`` the
 proposal of each zone), ``edge_index`` (2, E) holds both directions of every adjacency.
