@@ -10,13 +10,13 @@ and combined, ranked on held-out designs.
 A variant is a ``+``-joined list of changes to the ``train`` section of the params (the ``base``):
 ``focal`` / ``listwise`` (the objective), ``features`` / ``no_features`` (every proposal feature of
 `PROPOSAL_FEATURES`, or none), ``state_features`` (those and the `STATE_FEATURES`), ``late`` /
-``early`` (the fusion),
-``points`` / ``no_points`` (the zones' point geometry), ``context`` (the readout reads the state's
-proposals together), ``roundsN``, ``hiddenN`` (the width of
-every layer) and ``teacher`` (the listwise target shared with ``--teacher``'s scores: a student
-distilled from a trained checkpoint); e.g. ``listwise+features+early`` or
-``listwise+features+no_points+hidden48+teacher``. Without ``--variants`` the runner trains the
-base, every change alone, and the objective and features together with each of the others. Each variant is one
+``early`` (the fusion), ``points`` / ``no_points`` (the zones' point geometry), ``context`` (the
+readout reads the state's proposals together), ``cosine`` (the learning rate decayed to 0 over
+the run), ``roundsN``, ``hiddenN`` (the width of every layer) and ``teacher`` (the listwise
+target shared with ``--teacher``'s scores: a student distilled from a trained checkpoint); e.g.
+``listwise+features+early`` or ``listwise+features+no_points+hidden48+teacher``. Without
+``--variants`` the runner trains the base, every change alone, and the objective and features
+together with each of the others. Each variant is one
 training run of ``training.train`` (MLflow experiment ``ablations``) on a seeded sample of
 ``--designs`` training designs, so variants compare at equal data; a finished variant (its
 checkpoint and its config) is reused, so an interrupted ablation resumes. Every variant, random,
@@ -55,6 +55,7 @@ CHANGES: dict[str, dict[str, Any]] = {  # a variant's tokens, as overrides of th
     "points": {"use_points": True},
     "no_points": {"use_points": False},
     "context": {"context": True},
+    "cosine": {"lr_schedule": "cosine"},
 }
 
 
@@ -139,9 +140,11 @@ def describe(config: TrainConfig) -> str:
     points = "points" if config.use_points else "no points"
     names = " + ".join(Path(t).name for t in config.teacher)
     taught = f", {config.distill:g} taught by {names}" if config.teacher else ""
+    context = ", state context" if config.context else ""
+    rate = f", {config.lr_schedule} rate" if config.lr_schedule != "constant" else ""
     return (
         f"{config.loss}, {features}, {config.fusion} fusion, {points}, {config.rounds} rounds, "
-        f"hidden {config.hidden}{', state context' if config.context else ''}{taught}"
+        f"hidden {config.hidden}{context}{rate}{taught}"
     )
 
 

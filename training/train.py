@@ -43,6 +43,7 @@ from typing import Any
 import numpy as np
 import pyarrow.dataset as ds
 import torch
+from torch.optim.lr_scheduler import ConstantLR, CosineAnnealingLR, LRScheduler
 from torch_geometric.loader import DataLoader
 from tqdm import tqdm
 
@@ -61,6 +62,7 @@ from zonegraph.sequence.rankers import GTPlace, gt_place
 DEFAULT_TRACKING = "sqlite:///mlflow.db"
 LAST = "last.pt"  # the resumable state, beside the best checkpoint
 SELECT = "val_normalised"  # the validation metric that picks the best epoch (lower is better)
+SCHEDULES = ("constant", "cosine")
 RANK_ROWS = 2_000_000  # proposals x zones per numpy call when validation ranks a state
 Teachers = tuple[ProposalScorer, ...]
 
@@ -91,6 +93,9 @@ class TrainConfig(Config):
     temperature: float = 2.0  # of the teacher's softmax
     epochs: int = 3
     lr: float = 1e-3
+    # constant, or cosine: decayed to 0 over every batch of every epoch, so the run ends at rest
+    # instead of wherever its last steps at the full rate left it
+    lr_schedule: str = "constant"
     batch_states: int = 8  # states per batch (each with up to max_proposals proposals)
     max_proposals: int | None = 32  # None: every proposal of a state, the set its rank is judged on
     # zone copies (proposals x zones) per training state at most (None: no bound): 256 proposals of
@@ -130,6 +135,9 @@ class TrainConfig(Config):
         """One line naming what is wrong with the settings (SystemExit), before any data is read."""
         if self.loss not in LOSSES:
             raise SystemExit(f"train: unknown loss {self.loss!r} (one of {', '.join(LOSSES)})")
+        if self.lr_schedule not in SCHEDULES:
+            choices = ", ".join(SCHEDULES)
+            raise SystemExit(f"train: unknown lr_schedule {self.lr_schedule!r} (one of {choices})")
         if self.neutral_credit is not None and (self.loss != "listwise" or self.neutral_credit < 0):
             raise SystemExit("train: neutral_credit is a non-negative weight of the listwise loss")
         try:
@@ -412,11 +420,21 @@ def held_out_project(project: str, seed: int, fraction: float) -> bool:
 
 
 def resume_key(config: TrainConfig, version: str) -> dict[str, Any]:
-    """What a resumed run must share with the one it continues: every setting but the epoch
-    count and the device, and the labels."""
-    settings = {k: v for k, v in asdict(config).items() if k not in ("epochs", "device")}
+    """What a resumed run must share with the one it continues: every setting but the device,
+    and the labels; the epoch count too under a schedule, which it shapes (a constant-rate run
+    can be given more epochs and go on)."""
+    free = ("epochs", "device") if config.lr_schedule == "constant" else ("device",)
+    settings = {k: v for k, v in asdict(config).items() if k not in free}
     lists = {"features": list(config.features), "teacher": list(config.teacher)}
     return {**settings, **lists, "data_version": version}
+
+
+def lr_scheduler(optimiser: torch.optim.Optimizer, config: TrainConfig, batches: int) -> LRScheduler:
+    """The rate per optimiser step: constant, or a cosine from ``lr`` to 0 over ``epochs`` x
+    ``batches`` steps."""
+    if config.lr_schedule == "cosine":
+        return CosineAnnealingLR(optimiser, T_max=max(config.epochs * batches, 1))
+    return ConstantLR(optimiser, factor=1.0, total_iters=0)
 
 
 def load_last(path: Path, key: dict[str, Any], epochs: int) -> dict[str, Any] | None:
@@ -504,6 +522,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
             "projects: train it with the same holdout_fraction and holdout_seed"
         )
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
+    scheduler = lr_scheduler(optimiser, config, len(train_loader))
     out = Path(config.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     version = data_version(config.labels_dir)
@@ -515,6 +534,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
     if last is not None:
         model.load_state_dict(last["model"])
         optimiser.load_state_dict(last["optimiser"])
+        scheduler.load_state_dict(last["scheduler"])
         generator.set_state(last["generator"])
         torch.set_rng_state(last["torch_rng"])
         curve, best, first = last["curve"], last["best"], last["epoch"] + 1
@@ -558,6 +578,7 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
                 optimiser.zero_grad()
                 loss.backward()
                 optimiser.step()
+                scheduler.step()
                 losses.append(loss.item())
             places = rank_places(model, sets["rank"], device)
             row = {
@@ -579,7 +600,8 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
             if row[SELECT] <= best[SELECT] or not np.isfinite(best[SELECT]):
                 best = {**row, "val_steps": len(places)}
                 save_checkpoint(model, config, best, out / "scorer.pt", provenance)
-            save_last(out / LAST, model, optimiser, generator, key, epoch, curve, best, run.info.run_id)
+            progress = (optimiser, scheduler, generator)
+            save_last(out / LAST, model, progress, key, epoch, curve, best, run.info.run_id)
         if not curve:
             raise SystemExit("train: no epoch finished with a finite loss; no checkpoint written")
         write_curves(curve, out)
@@ -595,20 +617,22 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
 def save_last(
     path: Path,
     model: ProposalScorer,
-    optimiser: torch.optim.Optimizer,
-    generator: torch.Generator,
+    progress: tuple[torch.optim.Optimizer, LRScheduler, torch.Generator],
     key: dict[str, Any],
     epoch: int,
     curve: list[dict[str, Any]],
     best: dict[str, Any],
     run_id: str,
 ) -> None:
-    """Everything the next epoch needs, written atomically (a kill mid-write keeps the last one)."""
+    """Everything the next epoch needs (the optimiser's, the rate schedule's and the data order's
+    states among it), written atomically (a kill mid-write keeps the last one)."""
+    optimiser, scheduler, generator = progress
     state = {
         "key": key,
         "epoch": epoch,
         "model": model.state_dict(),
         "optimiser": optimiser.state_dict(),
+        "scheduler": scheduler.state_dict(),
         "generator": generator.get_state(),
         "torch_rng": torch.get_rng_state(),
         "curve": curve,

@@ -426,6 +426,39 @@ def test_a_stopped_run_resumes_from_its_last_epoch_in_the_same_mlflow_run(labell
 
 
 @requires_samples
+def test_a_cosine_rate_ends_at_rest_and_resumes_where_a_killed_run_stopped(labelled, tmp_path, monkeypatch):
+    import training.train as training_run
+
+    monkeypatch.chdir(tmp_path)
+    config = _quick(labelled, epochs=2, batch_states=1, loss="listwise", rounds=1, lr_schedule="cosine")
+    ranked = training_run.rank_places
+    calls = []
+
+    def killed_in_epoch_two(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt  # a kill after epoch 1's state was saved
+        return ranked(*args, **kwargs)
+
+    monkeypatch.setattr(training_run, "rank_places", killed_in_epoch_two)
+    with pytest.raises(KeyboardInterrupt):
+        train(config)
+    stopped = torch.load(tmp_path / "models" / "last.pt", weights_only=True)
+    batches = stopped["scheduler"]["last_epoch"]
+    assert stopped["epoch"] == 1 and batches > 1
+    assert 0.4 * config.lr < stopped["optimiser"]["param_groups"][0]["lr"] < config.lr  # half way down
+    train(config)  # resumes epoch 2 on the saved schedule
+    done = torch.load(tmp_path / "models" / "last.pt", weights_only=True)
+    assert done["epoch"] == 2 and done["run_id"] == stopped["run_id"]
+    assert done["scheduler"]["last_epoch"] == 2 * batches
+    assert done["optimiser"]["param_groups"][0]["lr"] < 1e-9  # at rest after the last batch
+    train(replace(config, epochs=3))  # the epoch count shapes the schedule: a new run, not more of this one
+    assert torch.load(tmp_path / "models" / "last.pt", weights_only=True)["run_id"] != done["run_id"]
+    with pytest.raises(SystemExit, match="lr_schedule"):
+        train(replace(config, lr_schedule="step"))
+
+
+@requires_samples
 def test_a_holdout_of_training_projects_is_never_trained_on_and_is_what_the_bench_searches(
     labelled, tmp_path, monkeypatch
 ):
