@@ -263,6 +263,26 @@ def summarise(ranks: pd.DataFrame, level: float = 0.9, seed: int = 0) -> pd.Data
     return pd.DataFrame(rows)
 
 
+def pooled(ranks: pd.DataFrame, members: Sequence[str], name: str) -> pd.DataFrame:
+    """``ranks`` with one more guide, ``name``: the step-by-step mean of ``members``' metrics.
+
+    A training recipe is a distribution over its seeds, and one training per side cannot tell
+    two recipes apart by less than the seeds' spread; the mean over each recipe's seeds, paired
+    by `ratios` over the same resampled designs, can. The members must have ranked the same
+    steps (ValueError otherwise)."""
+    group = ranks[ranks["guide"].isin(members)]
+    if missing := sorted(set(members) - set(group["guide"])):
+        raise ValueError(f"no ranks of {', '.join(missing)}")
+    keys = ["design_id", "step"]
+    if (group.groupby(keys).size() != len(set(members))).any():
+        raise ValueError(f"{name}: its members ranked different steps")
+    metrics = [m for m in METRICS if m in group]
+    means = group.groupby(keys)[metrics].mean()
+    first = group[group["guide"] == members[0]].set_index(keys).drop(columns=metrics)
+    mean = first.join(means).reset_index().assign(guide=name)
+    return pd.concat([ranks, mean[list(ranks.columns)]], ignore_index=True)
+
+
 def ratios(
     ranks: pd.DataFrame,
     base: str = "heuristic",
@@ -495,6 +515,13 @@ def main(argv: list[str] | None = None) -> None:
         default=None,
         help="summarise an earlier run's ranks.parquet (less --exclude, --part) instead of ranking",
     )
+    parser.add_argument(
+        "--pool",
+        nargs="*",
+        default=[],
+        metavar="NAME=GUIDE,GUIDE",
+        help="one more guide, the step-by-step mean of the listed guides (e.g. one recipe's seeds)",
+    )
     parser.add_argument("--out", type=Path, default=Path("eval_out/rank"))
     args = parser.parse_args(argv)
     if args.ranks is not None:
@@ -515,10 +542,16 @@ def main(argv: list[str] | None = None) -> None:
         ranks = guide_ranks(args.labels, args.graphs, guides, split, designs)
     if ranks.empty:
         raise SystemExit("rank: error: no designs left to rank")
+    args.out.mkdir(parents=True, exist_ok=True)
+    ranks.to_parquet(args.out / "ranks.parquet", index=False)  # the guides ranked, not the pools
+    for spec in args.pool:
+        name, _, members = spec.partition("=")
+        try:
+            ranks = pooled(ranks, members.split(","), name)
+        except ValueError as exc:
+            raise SystemExit(f"rank: error: --pool {spec}: {exc}") from None
     table = summarise(ranks, seed=args.seed)
     ratio = ratios(ranks, seed=args.seed)
-    args.out.mkdir(parents=True, exist_ok=True)
-    ranks.to_parquet(args.out / "ranks.parquet", index=False)
     records = {"guides": table.to_dict(orient="records"), "vs_heuristic": ratio.to_dict(orient="records")}
     text = markdown(table, ratio)
     folders = design_folders(args.designs_table)

@@ -173,6 +173,38 @@ def test_ranks_by_kind_of_step_split_each_guides_sum_and_pair_within_a_kind():
     assert by_kind(ranks.drop(columns="kind")).empty  # ranks written before steps had a kind
 
 
+def test_a_recipe_pooled_over_its_seeds_is_their_step_by_step_mean_and_pairs_like_a_guide(tmp_path):
+    from eval.rank import main, pooled, ratios
+
+    rows = []
+    for design, heuristic, seed0, seed1 in [("a", 0.4, 0.0, 0.2), ("b", 0.2, 0.3, 0.1), ("c", 0.6, 0.2, 0.2)]:
+        for guide, value in (("heuristic", heuristic), ("s0", seed0), ("s1", seed1)):
+            rows.append({"guide": guide, "design_id": design, "step": 0, "proposals": 5, "normalised": value})
+    ranks = pd.DataFrame(rows).assign(top1=lambda f: f["normalised"] == 0, top5=True, floor=0.2)
+    ranks["rank"] = 0.2 + 0.8 * ranks["normalised"]
+    both = pooled(ranks, ["s0", "s1"], "recipe")
+    recipe = both[both["guide"] == "recipe"].set_index("design_id")
+    assert recipe["normalised"].to_dict() == pytest.approx({"a": 0.1, "b": 0.2, "c": 0.2})
+    assert recipe.loc["a", "top1"] == 0.5  # hit rates pool to the members' share
+    assert len(both) == len(ranks) + 3 and set(both.columns) == set(ranks.columns)
+    paired = ratios(both, seed=3).set_index("guide")
+    assert paired.loc["recipe", "ratio"] == pytest.approx(0.5 / 1.2)
+    assert paired.loc["recipe", "ci_low"] <= paired.loc["recipe", "ratio"] <= paired.loc["recipe", "ci_high"]
+    with pytest.raises(ValueError, match="different steps"):
+        pooled(ranks[~((ranks["guide"] == "s1") & (ranks["design_id"] == "c"))], ["s0", "s1"], "recipe")
+    with pytest.raises(ValueError, match="no ranks of s2"):
+        pooled(ranks, ["s0", "s2"], "recipe")
+    ranks.to_parquet(tmp_path / "ranks.parquet")
+    out = tmp_path / "out"
+    earlier = ["--ranks", str(tmp_path / "ranks.parquet"), "--designs-table", str(tmp_path / "none")]
+    main([*earlier, "--pool", "recipe=s0,s1", "--out", str(out)])
+    assert "| recipe |" in (out / "rank.md").read_text()
+    stored = set(pd.read_parquet(out / "ranks.parquet")["guide"])
+    assert stored == {"heuristic", "s0", "s1"}  # the guides ranked; a pool is derived from them
+    with pytest.raises(SystemExit, match="--pool recipe=s0,s9: no ranks of s9"):
+        main([*earlier, "--pool", "recipe=s0,s9", "--out", str(out)])
+
+
 def test_an_earlier_runs_ranks_are_summarised_again_without_the_listed_designs(tmp_path):
     import json
 
