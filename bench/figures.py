@@ -323,10 +323,21 @@ def report_figure(folder: Path) -> dict:
 RANK_METRICS = ("rank", "floor", "normalised", "top1", "top5")
 
 
+def _ratios(rows: list[dict]) -> dict:
+    """`eval.rank.ratios` rows by guide: the ratio and its paired interval."""
+    return {
+        str(r["guide"]): {
+            "ratio": _rounded(r["ratio"], 3),
+            "ci": [_rounded(r["ci_low"], 3), _rounded(r["ci_high"], 3)],
+        }
+        for r in rows
+    }
+
+
 def rank_figure(results: dict) -> dict:
     """The GT rank per guide (``eval.rank``'s ``rank.json``): designs, ranked and single steps,
-    every scale with its 90% interval, and each guide's normalised rank over the heuristic's;
-    by timeline folder and by kind of step where the results have them."""
+    every scale with its 90% interval, and each guide's normalised rank over the heuristic's (and
+    over ``--base``'s); by timeline folder and by kind of step where the results have them."""
     guides = {}
     for r in results["guides"]:
         entry = {"designs": int(r["designs"]), "steps": int(r["steps"]), "single": int(r["single"])}
@@ -339,14 +350,10 @@ def rank_figure(results: dict) -> dict:
                     _rounded(r.get(f"{prefix}ci_high"), 4),
                 ]
         guides[str(r["guide"])] = entry
-    ratios = {
-        str(r["guide"]): {
-            "ratio": _rounded(r["ratio"], 3),
-            "ci": [_rounded(r["ci_low"], 3), _rounded(r["ci_high"], 3)],
-        }
-        for r in results.get("vs_heuristic", [])
-    }
-    figure = {"guides": guides, "vs_heuristic": ratios}
+    figure = {"guides": guides, "vs_heuristic": _ratios(results.get("vs_heuristic", []))}
+    if results.get("vs_base"):
+        base = str(results["vs_base"][0]["base"])
+        figure["vs_base"] = {"base": base, "ratios": _ratios(results["vs_base"])}
     if results.get("by_folder"):
         figure["by_folder"] = [
             {

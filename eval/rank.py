@@ -444,12 +444,17 @@ def markdown(table: pd.DataFrame, ratio: pd.DataFrame | None = None) -> str:
         lines.append(head + " | ".join(cells) + " |")
     text = "\n".join(lines) + "\n\n" + LEGEND
     if ratio is not None and len(ratio):
-        base = ratio["base"].iloc[0]
-        text += f"\n| guide | normalised rank / {base}'s | 90% CI (paired) |\n|---|---|---|\n"
-        text += "".join(
-            f"| {r.guide} | {r.ratio:.3f} | {r.ci_low:.3f} - {r.ci_high:.3f} |\n" for r in ratio.itertuples()
-        )
+        text += "\n" + ratio_markdown(ratio)
     return text
+
+
+def ratio_markdown(ratio: pd.DataFrame) -> str:
+    """`ratios` as a Markdown table: each guide's normalised rank over its base's."""
+    base = ratio["base"].iloc[0]
+    text = f"| guide | normalised rank / {base}'s | 90% CI (paired) |\n|---|---|---|\n"
+    return text + "".join(
+        f"| {r.guide} | {r.ratio:.3f} | {r.ci_low:.3f} - {r.ci_high:.3f} |\n" for r in ratio.itertuples()
+    )
 
 
 def plot_ranks(table: pd.DataFrame, path: Path) -> Path:
@@ -522,6 +527,11 @@ def main(argv: list[str] | None = None) -> None:
         metavar="NAME=GUIDE,GUIDE",
         help="one more guide, the step-by-step mean of the listed guides (e.g. one recipe's seeds)",
     )
+    parser.add_argument(
+        "--base",
+        default=None,
+        help="also every guide's normalised rank over this guide's, paired (e.g. one pooled recipe)",
+    )
     parser.add_argument("--out", type=Path, default=Path("eval_out/rank"))
     args = parser.parse_args(argv)
     if args.ranks is not None:
@@ -554,6 +564,15 @@ def main(argv: list[str] | None = None) -> None:
     ratio = ratios(ranks, seed=args.seed)
     records = {"guides": table.to_dict(orient="records"), "vs_heuristic": ratio.to_dict(orient="records")}
     text = markdown(table, ratio)
+    if args.base is not None:
+        against = ratios(ranks, base=args.base, seed=args.seed)
+        if against.empty:
+            raise SystemExit(
+                f"rank: error: --base {args.base}: no such guide, or none other on its designs "
+                f"(the ranks are in {args.out / 'ranks.parquet'}: summarise them again with --ranks)"
+            )
+        records["vs_base"] = against.to_dict(orient="records")
+        text += "\n" + ratio_markdown(against)
     folders = design_folders(args.designs_table)
     if folders:
         per = by_folder(ranks, folders, seed=args.seed)

@@ -353,22 +353,27 @@ def rank(records: list[dict]) -> str:
         low, high = g[f"{metric}_ci"]
         return f"{g[metric]:.{digits}f} ({low:.{digits}f} - {high:.{digits}f})"
 
-    ratios = []
+    ratios, against = [], []
     for r in records:
         for name, g in r["figure"]["guides"].items():
             scales = [cell(g, "rank", 4), f"{g['floor']:.4f}", cell(g, "normalised", 4)]
             scales += [cell(g, "top1", 3), cell(g, "top5", 3)]
             head = f"| {r['name']} | {name} | {g['designs']} | {g['steps']} ({g['single']}) | "
             lines.append(head + " | ".join(scales) + " |")
-        for name, v in r["figure"]["vs_heuristic"].items():
-            ratios.append(
-                f"| {r['name']} | {name} | {v['ratio']:.3f} | {v['ci'][0]:.3f} - {v['ci'][1]:.3f} |"
-            )
+        ratios += _ratio_rows(r["name"], r["figure"]["vs_heuristic"])
+        if "vs_base" in r["figure"]:
+            base = r["figure"]["vs_base"]
+            against += _ratio_rows(r["name"], base["ratios"], base["base"])
     text = "\n".join(lines)
     if ratios:
         text += (
             "\n\n| run | guide | normalised rank / heuristic's | 90% CI (paired) |\n|---|---|---|---|\n"
             + "\n".join(ratios)
+        )
+    if against:
+        text += (
+            "\n\n| run | guide | base | normalised rank / base's | 90% CI (paired) |\n|---|---|---|---|---|\n"
+            + "\n".join(against)
         )
     folders = [_folder_rows(r) for r in records if r["figure"].get("by_folder")]
     if folders:
@@ -386,6 +391,15 @@ def rank(records: list[dict]) -> str:
             "|---|---|---|---|---|---|---|---|\n" + "\n".join(row for rows in kinds for row in rows)
         )
     return text + "\n\nMeasured by:\n\n" + _sources(records)
+
+
+def _ratio_rows(run: str, ratios: dict, base: str | None = None) -> list[str]:
+    """One table row per guide: its ratio to the base (the heuristic unless named) and interval."""
+    named = "" if base is None else f" {base} |"
+    return [
+        f"| {run} | {name} |{named} {v['ratio']:.3f} | {v['ci'][0]:.3f} - {v['ci'][1]:.3f} |"
+        for name, v in ratios.items()
+    ]
 
 
 def _ratio_cell(value: float | None, low: float | None, high: float | None) -> str:

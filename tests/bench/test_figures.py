@@ -360,6 +360,13 @@ def test_the_rank_figure_keeps_every_scale_with_its_interval_and_the_ratio():
     table = _hook().rank([record | {"figure": figure}])
     assert "| run | other_completes | net | 141 | 0.343 | 0.3628 | 0.004 | 0.905 (0.851 - 0.953) |" in table
     assert "| run | other_completes | heuristic | 141 | 0.343 | 0.3628 | 0.004 | - |" in table
+    assert "base's" not in table
+    pooled = {"guide": "cosine", "base": "constant", "ratio": 0.9124, "ci_low": 0.87, "ci_high": 0.951}
+    figure = rank_figure(results | {"vs_base": [pooled]})
+    ratio = {"ratio": 0.912, "ci": [0.87, 0.951]}
+    assert figure["vs_base"] == {"base": "constant", "ratios": {"cosine": ratio}}
+    table = _hook().rank([record | {"figure": figure}])
+    assert "| run | cosine | constant | 0.912 | 0.870 - 0.951 |" in table
 
 
 def test_the_heavy_figure_shows_each_stage_before_and_after_and_what_ran_out_of_time():

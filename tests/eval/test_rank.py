@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -197,12 +198,17 @@ def test_a_recipe_pooled_over_its_seeds_is_their_step_by_step_mean_and_pairs_lik
     ranks.to_parquet(tmp_path / "ranks.parquet")
     out = tmp_path / "out"
     earlier = ["--ranks", str(tmp_path / "ranks.parquet"), "--designs-table", str(tmp_path / "none")]
-    main([*earlier, "--pool", "recipe=s0,s1", "--out", str(out)])
+    main([*earlier, "--pool", "recipe=s0,s1", "--base", "recipe", "--out", str(out)])
     assert "| recipe |" in (out / "rank.md").read_text()
+    against = json.loads((out / "rank.json").read_text())["vs_base"]
+    assert {r["guide"]: r["base"] for r in against} == {"heuristic": "recipe", "s0": "recipe", "s1": "recipe"}
+    assert "| s0 | " in (out / "rank.md").read_text().split("normalised rank / recipe's")[1]
     stored = set(pd.read_parquet(out / "ranks.parquet")["guide"])
     assert stored == {"heuristic", "s0", "s1"}  # the guides ranked; a pool is derived from them
     with pytest.raises(SystemExit, match="--pool recipe=s0,s9: no ranks of s9"):
         main([*earlier, "--pool", "recipe=s0,s9", "--out", str(out)])
+    with pytest.raises(SystemExit, match="--base s7: no such guide"):
+        main([*earlier, "--base", "s7", "--out", str(out)])
 
 
 def test_an_earlier_runs_ranks_are_summarised_again_without_the_listed_designs(tmp_path):
