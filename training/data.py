@@ -31,6 +31,18 @@ def _mask(ids: Sequence[int], n: int) -> np.ndarray:
     return out
 
 
+def kept_proposals(
+    zones: int, positives: int, max_proposals: int | None, max_nodes: int | None
+) -> int | None:
+    """The most proposals a training state of ``zones`` zones keeps (None: all): ``max_proposals``,
+    fewer where ``max_nodes`` zone copies run out first (never fewer than the positives and one
+    other)."""
+    if max_nodes is None:
+        return max_proposals
+    by_nodes = max(max_nodes // max(zones, 1), positives + 1)
+    return by_nodes if max_proposals is None else min(max_proposals, by_nodes)
+
+
 @dataclass
 class _State:
     design_id: str
@@ -117,19 +129,11 @@ class LabelDataset(Dataset):
             return np.arange(len(state.labels))
         pos = np.flatnonzero(state.labels == 1)
         neg = np.flatnonzero(state.labels == -1 if not self.neutrals else state.labels != 1)
-        limit = self._limit(state.zones.shape[1], len(pos))
+        limit = kept_proposals(state.zones.shape[1], len(pos), self.max_proposals, self.max_nodes)
         if limit is not None and len(neg) > limit - len(pos):
             rng = np.random.default_rng([self.seed, idx])
             neg = np.sort(rng.choice(neg, limit - len(pos), replace=False))
         return np.concatenate([pos, neg])
-
-    def _limit(self, zones: int, positives: int) -> int | None:
-        """The most proposals a training state of ``zones`` zones keeps: ``max_proposals``, fewer
-        where ``max_nodes`` zone copies run out first (never fewer than the positives and one other)."""
-        if self.max_nodes is None:
-            return self.max_proposals
-        by_nodes = max(self.max_nodes // max(zones, 1), positives + 1)
-        return by_nodes if self.max_proposals is None else min(self.max_proposals, by_nodes)
 
     def get(self, idx: int) -> StateData:
         state = self.states[idx]
