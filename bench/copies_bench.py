@@ -22,24 +22,25 @@ from pathlib import Path
 
 import pandas as pd
 import pyarrow.dataset as ds
-import pyarrow.parquet as pq
 
 from bench.corpus import write_results
 from training.data import kept_proposals
 from training.shards import label_shards
+from zonegraph.zones.storage import saved_zone_count
 
 
 def training_states(labels: Path, graphs: Path, split: str) -> pd.DataFrame:
     """One row per labelled state of ``split``: its design, zones, proposals and positives."""
     shards = label_shards(labels).proposals
-    table = ds.dataset(shards, format="parquet").to_table(columns=["design_id", "split", "step", "label"])
+    table = ds.dataset(shards, format="parquet").to_table(
+        columns=["design_id", "step", "label"], filter=ds.field("split") == split
+    )
     rows = table.to_pandas()
-    rows = rows[rows["split"] == split]
     states = rows.groupby(["design_id", "step"], sort=True)["label"].agg(
         proposals="size", positives=lambda labels: int((labels == 1).sum())
     )
     states = states.reset_index()
-    zones = {d: pq.read_metadata(graphs / d / "zones.parquet").num_rows for d in states["design_id"].unique()}
+    zones = {d: saved_zone_count(graphs / d) for d in states["design_id"].unique()}
     return states.assign(zones=states["design_id"].map(zones))
 
 

@@ -59,7 +59,7 @@ def write_results(rows: list[dict], table: str, out: Path) -> None:
 
 def closest_graphs(folder: Path, targets: list[int]) -> dict[int, Path]:
     """The saved graph whose zone count is closest to each target (read from the zone tables)."""
-    import pyarrow.parquet as pq
+    from zonegraph.zones.storage import saved_zone_count
 
-    counts = {g: pq.read_metadata(g / "zones.parquet").num_rows for g in sorted(folder.iterdir())}
+    counts = {g: saved_zone_count(g) for g in sorted(folder.iterdir())}
     return {t: min(counts, key=lambda g: abs(counts[g] - t)) for t in targets}

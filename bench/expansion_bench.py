@@ -24,28 +24,22 @@ from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
-import pyarrow.parquet as pq
 
 from bench.corpus import write_results
 from zonegraph.errors import ZoneGraphError
 from zonegraph.sequence.best_first import SearchConfig, search
 from zonegraph.sequence.proposals import ProposalGenerator
 from zonegraph.sequence.rankers import HeuristicRanker
-from zonegraph.zones.storage import load_zone_graph
+from zonegraph.zones.storage import load_zone_graph, saved_zone_count
 
 T = TypeVar("T")
-
-
-def zone_count(folder: Path) -> int:
-    """A saved graph's zones, from its Parquet footer (nothing else is read)."""
-    return pq.ParquetFile(folder / "zones.parquet").metadata.num_rows
 
 
 def drawn(graphs: Path, sample: int, seed: int, min_zones: int, exclude: set[str]) -> list[str]:
     """``sample`` graph ids drawn uniformly (seeded) among those of at least ``min_zones`` zones."""
     saved = (p for p in graphs.iterdir() if (p / "zones.parquet").is_file())
     ids = sorted(p.name for p in saved if p.name not in exclude)
-    kept = [i for i in ids if zone_count(graphs / i) >= min_zones] if min_zones else ids
+    kept = [i for i in ids if saved_zone_count(graphs / i) >= min_zones] if min_zones else ids
     return sorted(random.Random(seed).sample(kept, min(sample, len(kept))))
 
 

@@ -600,8 +600,9 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
             if row[SELECT] <= best[SELECT] or not np.isfinite(best[SELECT]):
                 best = {**row, "val_steps": len(places)}
                 save_checkpoint(model, config, best, out / "scorer.pt", provenance)
-            progress = (optimiser, scheduler, generator)
-            save_last(out / LAST, model, progress, key, epoch, curve, best, run.info.run_id)
+            save_last(
+                out / LAST, model, optimiser, scheduler, generator, key, epoch, curve, best, run.info.run_id
+            )
         if not curve:
             raise SystemExit("train: no epoch finished with a finite loss; no checkpoint written")
         write_curves(curve, out)
@@ -617,7 +618,9 @@ def train(config: TrainConfig, fresh: bool = False) -> dict[str, Any]:
 def save_last(
     path: Path,
     model: ProposalScorer,
-    progress: tuple[torch.optim.Optimizer, LRScheduler, torch.Generator],
+    optimiser: torch.optim.Optimizer,
+    scheduler: LRScheduler,
+    generator: torch.Generator,
     key: dict[str, Any],
     epoch: int,
     curve: list[dict[str, Any]],
@@ -626,7 +629,6 @@ def save_last(
 ) -> None:
     """Everything the next epoch needs (the optimiser's, the rate schedule's and the data order's
     states among it), written atomically (a kill mid-write keeps the last one)."""
-    optimiser, scheduler, generator = progress
     state = {
         "key": key,
         "epoch": epoch,

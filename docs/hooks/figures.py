@@ -395,11 +395,12 @@ def rank(records: list[dict]) -> str:
 
 def _ratio_rows(run: str, ratios: dict, base: str | None = None) -> list[str]:
     """One table row per guide: its ratio to the base (the heuristic unless named) and interval."""
-    named = "" if base is None else f" {base} |"
-    return [
-        f"| {run} | {name} |{named} {v['ratio']:.3f} | {v['ci'][0]:.3f} - {v['ci'][1]:.3f} |"
-        for name, v in ratios.items()
-    ]
+    rows = []
+    for name, v in ratios.items():
+        interval = f"{v['ci'][0]:.3f} - {v['ci'][1]:.3f}"
+        cells = [run, name, *([base] if base else []), f"{v['ratio']:.3f}", interval]
+        rows.append("| " + " | ".join(cells) + " |")
+    return rows
 
 
 def _ratio_cell(value: float | None, low: float | None, high: float | None) -> str:
